@@ -1,0 +1,50 @@
+"""Soil: a Hertz--Mindlin DEM of polydisperse spheres on Taichi, and regolith-bed preparation.
+
+Public API::
+
+    Scene                    spheres, walls, stepping, NumPy read-back
+    Material, PairProperties materials (E, nu, rho) and pair properties (e, mu_s, mu_r)
+    LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL   seed-004 Table 1 defaults
+    estimate_time_step       Rayleigh / Hertz stable-step estimate
+    BedSpec, prepare_bed, load_bed, Bed                 soil-bed preparation with an HDF5 cache
+"""
+
+from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
+from .materials import (
+    LUNAR_SOIL_SIMULANT,
+    SOIL_SOIL,
+    SOIL_STEEL,
+    STEEL,
+    Material,
+    PairProperties,
+    effective_mass,
+    effective_modulus,
+    effective_radius,
+    effective_shear_modulus,
+    restitution_damping_ratio,
+)
+from .runtime import init
+from .scene import Scene, Wall
+from .timestep import TimeStepEstimate, estimate_time_step
+
+__all__ = [
+    "CapacityError",
+    "LUNAR_SOIL_SIMULANT",
+    "Material",
+    "PairProperties",
+    "SOIL_SOIL",
+    "SOIL_STEEL",
+    "STEEL",
+    "Scene",
+    "SimulationUnstableError",
+    "TimeStepEstimate",
+    "Wall",
+    "WheelsoilInputError",
+    "effective_mass",
+    "effective_modulus",
+    "effective_radius",
+    "effective_shear_modulus",
+    "estimate_time_step",
+    "init",
+    "restitution_damping_ratio",
+]

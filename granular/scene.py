@@ -1,0 +1,600 @@
+"""The scriptable DEM scene: spheres, planar walls, materials, stepping, NumPy in and out.
+
+Example
+-------
+>>> import numpy as np
+>>> from wheelsoil.granular import Scene
+>>> scene = Scene(domain_min=(0, 0, 0), domain_max=(0.2, 0.2, 0.3))
+>>> scene.add_box_walls()                                       # floor and four side walls
+>>> scene.add_spheres(positions=np.array([[0.1, 0.1, 0.05]]), radii=np.array([0.01]))
+>>> scene.step(100)
+>>> scene.positions.shape
+(1, 3)
+
+State lives in Taichi arrays while the scene steps; the properties below return NumPy copies.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import taichi as ti
+
+from . import forces, integrator, neighbors, runtime
+from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
+from .materials import (
+    LUNAR_SOIL_SIMULANT,
+    SOIL_SOIL,
+    SOIL_STEEL,
+    STEEL,
+    Material,
+    PairProperties,
+    effective_modulus,
+    effective_shear_modulus,
+)
+from .timestep import TimeStepEstimate, estimate_time_step
+
+
+@dataclass(frozen=True)
+class Wall:
+    """An infinite rigid plane. ``normal`` points into the side where particles live.
+
+    ``material=None`` makes the wall perfectly rigid (E = infinity).
+    """
+
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+    material: Material | None
+    pair: PairProperties
+
+
+def _as_array(name: str, value, shape_tail: tuple[int, ...], n: int | None = None) -> np.ndarray:
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim == len(shape_tail):  # a single item
+        arr = arr[None, ...]
+    if arr.shape[1:] != shape_tail or (n is not None and arr.shape[0] != n):
+        want = ("N" if n is None else str(n),) + tuple(str(s) for s in shape_tail)
+        raise WheelsoilInputError(f"{name} has shape {arr.shape}; expected ({', '.join(want)})")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        idx = np.argwhere(bad)[0]
+        raise WheelsoilInputError(
+            f"{name} contains a non-finite value {arr[tuple(idx)]!r} at index {tuple(int(i) for i in idx)}"
+        )
+    return np.ascontiguousarray(arr)
+
+
+def neighbor_row_width(r_min: float, r_max: float, skin: float) -> int:
+    """Upper estimate of the number of partners within r_i + r_j + skin of the largest sphere.
+
+    Spheres of radius r_min whose centres lie within r_max + r_min + skin occupy at most 74 % (the
+    densest packing) of the shell between r_max and r_max + 2 r_min + skin. Rows that still overflow
+    are widened automatically.
+    """
+    outer = r_max + 2.0 * r_min + skin
+    return int(math.ceil(0.74 * (outer**3 - r_max**3) / r_min**3)) + 2
+
+
+class Scene:
+    """A DEM scene of polydisperse spheres of one material and any number of planar walls.
+
+    Parameters
+    ----------
+    domain_min, domain_max:
+        Corners of the box [m] the particles must stay in (it sizes the neighbour grid); a particle
+        leaving it stops the run with :class:`SimulationUnstableError`.
+    gravity:
+        Gravity vector [m/s^2]; e.g. ``(0, 0, -9.81)`` or ``(0, 0, -1.62)`` for the Moon.
+    material, pair:
+        Particle material and soil--soil pair properties (default: seed 004 Table 1).
+    skin:
+        Verlet skin [m]; default 15 % of the smallest particle diameter.
+    cell_size:
+        Neighbour-grid cell edge [m]; default and minimum 2 r_max + skin.
+    impact_speed:
+        Largest expected relative contact speed [m/s] for the Hertz time-step estimate.
+    check_interval:
+        Steps between health checks (NaN, escaped particles, energy blow-up).
+    arch:
+        Taichi backend (``"cpu"`` default, ``"cuda"``...); see :func:`wheelsoil.granular.runtime.init`.
+    """
+
+    def __init__(
+        self,
+        domain_min,
+        domain_max,
+        *,
+        gravity=(0.0, 0.0, -9.81),
+        material: Material = LUNAR_SOIL_SIMULANT,
+        pair: PairProperties = SOIL_SOIL,
+        skin: float | None = None,
+        cell_size: float | None = None,
+        impact_speed: float = 1.0,
+        check_interval: int = 200,
+        arch: str | None = None,
+    ) -> None:
+        self.domain_min = _as_array("domain_min", domain_min, (3,), 1)[0]
+        self.domain_max = _as_array("domain_max", domain_max, (3,), 1)[0]
+        if np.any(self.domain_max <= self.domain_min):
+            raise WheelsoilInputError(
+                f"domain_max {self.domain_max.tolist()} must exceed domain_min {self.domain_min.tolist()} on every axis"
+            )
+        self.gravity = _as_array("gravity", gravity, (3,), 1)[0]
+        if not isinstance(material, Material):
+            raise WheelsoilInputError(f"material must be a wheelsoil.granular.Material, got {type(material).__name__}")
+        if not isinstance(pair, PairProperties):
+            raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
+        self.material = material
+        self.pair = pair
+        for name, value in (("skin", skin), ("cell_size", cell_size)):
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise WheelsoilInputError(f"{name} = {value!r} m must be a finite number > 0")
+        if not (math.isfinite(impact_speed) and impact_speed > 0):
+            raise WheelsoilInputError(f"impact_speed = {impact_speed!r} m/s must be > 0")
+        if int(check_interval) < 1:
+            raise WheelsoilInputError(f"check_interval = {check_interval!r} must be >= 1")
+        self._skin_request = skin
+        self._cell_request = cell_size
+        self.impact_speed = float(impact_speed)
+        self.check_interval = int(check_interval)
+        self.arch = runtime.init(arch)
+
+        self.walls: list[Wall] = []
+        self.time = 0.0
+        self.steps_taken = 0
+        self._dt: float | None = None
+        self._n_contacts = 0
+        self.neighbor_rebuilds = 0
+        # host copy of the state (authoritative while self._dev is None)
+        self._x = np.zeros((0, 3))
+        self._v = np.zeros((0, 3))
+        self._w = np.zeros((0, 3))
+        self._r = np.zeros(0)
+        self._f = np.zeros((0, 3))
+        self._t = np.zeros((0, 3))
+        self._hist: dict | None = None  # neighbour rows and tangential history on the host
+        self._dev: dict | None = None
+
+    # ------------------------------------------------------------------ building the scene
+    def add_wall(
+        self,
+        point,
+        normal,
+        *,
+        material: Material | None = STEEL,
+        pair: PairProperties = SOIL_STEEL,
+    ) -> int:
+        """Add an infinite plane through ``point`` [m] whose ``normal`` points towards the particles.
+
+        Returns the wall's index. ``material=None`` is a perfectly rigid wall.
+        """
+        p = _as_array("wall point", point, (3,), 1)[0]
+        nrm = _as_array("wall normal", normal, (3,), 1)[0]
+        length = float(np.linalg.norm(nrm))
+        if length == 0.0:
+            raise WheelsoilInputError("wall normal (0, 0, 0) has no direction")
+        if material is not None and not isinstance(material, Material):
+            raise WheelsoilInputError(f"wall material must be a Material or None, got {type(material).__name__}")
+        if not isinstance(pair, PairProperties):
+            raise WheelsoilInputError(f"wall pair must be a PairProperties, got {type(pair).__name__}")
+        self._to_host()
+        self.walls.append(Wall(tuple(p), tuple(nrm / length), material, pair))
+        if self._hist is not None:
+            self._hist["xi_wall"] = np.concatenate(
+                [self._hist["xi_wall"], np.zeros((self.n_particles, 1, 3))], axis=1
+            )
+        return len(self.walls) - 1
+
+    def add_box_walls(
+        self,
+        lo=None,
+        hi=None,
+        *,
+        top: bool = False,
+        material: Material | None = STEEL,
+        pair: PairProperties = SOIL_STEEL,
+    ) -> list[int]:
+        """Floor and four side walls of the box ``[lo, hi]`` (default: the domain); ``top`` adds a lid."""
+        lo = self.domain_min if lo is None else _as_array("lo", lo, (3,), 1)[0]
+        hi = self.domain_max if hi is None else _as_array("hi", hi, (3,), 1)[0]
+        planes = [
+            (lo, (0, 0, 1)),
+            (lo, (1, 0, 0)),
+            (hi, (-1, 0, 0)),
+            (lo, (0, 1, 0)),
+            (hi, (0, -1, 0)),
+        ]
+        if top:
+            planes.append((hi, (0, 0, -1)))
+        return [self.add_wall(p, n, material=material, pair=pair) for p, n in planes]
+
+    def add_spheres(self, positions, radii, velocities=None, angular_velocities=None) -> slice:
+        """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
+
+        Returns the slice of particle indices they received. Every sphere must lie inside the domain.
+        """
+        x = _as_array("positions", positions, (3,))
+        n = x.shape[0]
+        r = _as_array("radii", radii, (), n) if np.ndim(radii) else np.full(n, float(radii))
+        if np.ndim(radii) == 0 and not (math.isfinite(float(radii))):
+            raise WheelsoilInputError(f"radii = {radii!r} must be finite")
+        bad = np.flatnonzero(r <= 0.0)
+        if bad.size:
+            raise WheelsoilInputError(f"radius {r[bad[0]]!r} m of sphere {int(bad[0])} is invalid: radii must be > 0")
+        v = np.zeros((n, 3)) if velocities is None else _as_array("velocities", velocities, (3,), n)
+        w = np.zeros((n, 3)) if angular_velocities is None else _as_array("angular_velocities", angular_velocities, (3,), n)
+        outside = np.flatnonzero(np.any((x < self.domain_min) | (x > self.domain_max), axis=1))
+        if outside.size:
+            k = int(outside[0])
+            raise WheelsoilInputError(
+                f"sphere {k} at {x[k].tolist()} m lies outside the domain "
+                f"[{self.domain_min.tolist()}, {self.domain_max.tolist()}] ({outside.size} spheres outside)"
+            )
+        self._to_host()
+        start = self.n_particles
+        self._x = np.concatenate([self._x, x])
+        self._v = np.concatenate([self._v, v])
+        self._w = np.concatenate([self._w, w])
+        self._r = np.concatenate([self._r, r])
+        self._f = np.concatenate([self._f, np.zeros((n, 3))])
+        self._t = np.concatenate([self._t, np.zeros((n, 3))])
+        if self._hist is not None:
+            h = self._hist
+            h["nbr"] = np.concatenate([h["nbr"], np.zeros((n, h["nbr"].shape[1]), np.int32)])
+            h["count"] = np.concatenate([h["count"], np.zeros(n, np.int32)])
+            h["xi"] = np.concatenate([h["xi"], np.zeros((n,) + h["xi"].shape[1:])])
+            h["xi_wall"] = np.concatenate([h["xi_wall"], np.zeros((n,) + h["xi_wall"].shape[1:])])
+        return slice(start, start + n)
+
+    def keep_spheres(self, mask) -> None:
+        """Keep only the spheres where ``mask`` is true (contact history of kept pairs is preserved)."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != (self.n_particles,):
+            raise WheelsoilInputError(f"mask has shape {mask.shape}; expected ({self.n_particles},)")
+        self._to_host()
+        for name in ("_x", "_v", "_w", "_r", "_f", "_t"):
+            setattr(self, name, getattr(self, name)[mask])
+        if self._hist is not None:
+            h = self._hist
+            new_index = np.full(mask.size, -1, np.int64)
+            new_index[mask] = np.arange(int(mask.sum()))
+            nbr, count, xi = h["nbr"][mask], h["count"][mask], h["xi"][mask]
+            width = nbr.shape[1]
+            valid = np.arange(width)[None, :] < count[:, None]
+            mapped = np.where(valid, new_index[nbr], -1)
+            keep = mapped >= 0
+            order = np.argsort(~keep, axis=1, kind="stable")  # kept entries first, order preserved
+            mapped = np.take_along_axis(mapped, order, axis=1)
+            xi = np.take_along_axis(xi, order[:, :, None], axis=1)
+            h["count"] = keep.sum(axis=1).astype(np.int32)
+            h["nbr"] = np.where(mapped >= 0, mapped, 0).astype(np.int32)
+            h["xi"] = np.where((mapped >= 0)[:, :, None], xi, 0.0)
+            h["xi_wall"] = h["xi_wall"][mask]
+
+    def set_velocities(self, velocities=None, angular_velocities=None) -> None:
+        """Overwrite translational [m/s] and/or angular [rad/s] velocities, (N, 3) each."""
+        self._to_host()
+        if velocities is not None:
+            self._v = _as_array("velocities", velocities, (3,), self.n_particles)
+        if angular_velocities is not None:
+            self._w = _as_array("angular_velocities", angular_velocities, (3,), self.n_particles)
+
+    # ------------------------------------------------------------------ time step
+    @property
+    def skin(self) -> float:
+        if self._skin_request is not None:
+            return float(self._skin_request)
+        return 0.15 * 2.0 * float(self._r.min()) if self.n_particles else 0.0
+
+    def stable_time_step(self, impact_speed: float | None = None) -> TimeStepEstimate:
+        """Rayleigh and Hertz estimates for the smallest sphere (see :mod:`.timestep`)."""
+        if self.n_particles == 0:
+            raise WheelsoilInputError("the scene has no spheres; add some before asking for a time step")
+        r_min = float(self._r.min()) if self._dev is None else float(self._dev["r_min"])
+        wall_moduli = tuple(effective_modulus(self.material, w.material) for w in self.walls)
+        return estimate_time_step(
+            r_min,
+            self.material,
+            wall_moduli=wall_moduli,
+            impact_speed=impact_speed or self.impact_speed,
+        )
+
+    @property
+    def time_step(self) -> float:
+        """Current time step [s] (the stable estimate unless one was set)."""
+        if self._dt is None:
+            self._dt = self.stable_time_step().stable
+        return self._dt
+
+    @time_step.setter
+    def time_step(self, dt: float) -> None:
+        self.set_time_step(dt)
+
+    def set_time_step(self, dt: float) -> None:
+        """Use ``dt`` [s]; a step above the stable estimate is refused with the numbers."""
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt > 0):
+            raise WheelsoilInputError(f"time step {dt!r} s must be a finite number > 0")
+        est = self.stable_time_step()
+        if dt > est.stable * (1.0 + 1e-12):
+            raise WheelsoilInputError(
+                f"time step {dt:.3e} s exceeds the stable time step: {est.describe()}"
+            )
+        self._dt = dt
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, n: int = 1, *, callback: Callable[[Scene], None] | None = None, callback_every: int = 0) -> None:
+        """Advance ``n`` steps of ``time_step``; ``callback(scene)`` runs every ``callback_every`` steps."""
+        n = int(n)
+        if n < 0:
+            raise WheelsoilInputError(f"number of steps {n} must be >= 0")
+        if self.n_particles == 0:
+            raise WheelsoilInputError("the scene has no spheres to step")
+        dt = self.time_step
+        d = self._to_device()
+        g = self.gravity.tolist()
+        half_skin2 = (0.5 * d["skin"]) ** 2
+        for k in range(n):
+            largest = integrator.kick_drift(
+                d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], g, dt, d["x_ref"]
+            )
+            if largest > half_skin2:
+                self._rebuild_neighbors()
+            self._n_contacts = self._compute_forces(dt)
+            integrator.kick(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], g, dt)
+            self.time += dt
+            self.steps_taken += 1
+            if self.steps_taken % self.check_interval == 0:
+                self.check_health()
+            if callback is not None and callback_every and (k + 1) % callback_every == 0:
+                callback(self)
+
+    def _compute_forces(self, dt: float) -> int:
+        d = self._dev
+        return forces.contact_forces(
+            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
+            d["nbr"], d["count"], d["xi"],
+            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"],
+            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction,
+            dt, d["f"], d["t"],
+        )
+
+    def check_health(self) -> dict:
+        """Stop with :class:`SimulationUnstableError` on NaN, escaped particles or runaway speeds.
+
+        Returns the health figures: ``kinetic_energy`` [J], ``max_speed`` [m/s].
+        """
+        d = self._to_device()
+        out = d["health"]
+        integrator.state_health(
+            d["x"], d["v"], d["w"], d["m"], d["I"],
+            self.domain_min.tolist(), self.domain_max.tolist(), out,
+        )
+        bad, outside, vmax2, energy = out.to_numpy()
+        where = f"at t = {self.time:.6g} s (step {self.steps_taken})"
+        if bad:
+            raise SimulationUnstableError(
+                f"{int(bad)} particles have non-finite position or velocity {where}; "
+                f"the time step {self.time_step:.3e} s may be too large ({self.stable_time_step().describe()})"
+            )
+        if outside:
+            raise SimulationUnstableError(
+                f"{int(outside)} particles left the domain [{self.domain_min.tolist()}, "
+                f"{self.domain_max.tolist()}] m {where}; the bin may be missing a wall or the run blew up"
+            )
+        vmax = math.sqrt(vmax2)
+        limit = 0.2 * d["r_min"] / self.time_step
+        if vmax > limit:
+            raise SimulationUnstableError(
+                f"energy blow-up {where}: a particle moves at {vmax:.3g} m/s, more than 0.2 r_min per step "
+                f"({limit:.3g} m/s); kinetic energy {energy:.3g} J. Reduce the time step "
+                f"({self.stable_time_step().describe()})"
+            )
+        return {"kinetic_energy": float(energy), "max_speed": vmax}
+
+    # ------------------------------------------------------------------ device state
+    def _to_device(self) -> dict:
+        if self._dev is not None:
+            return self._dev
+        n = self.n_particles
+        r_min, r_max = float(self._r.min()), float(self._r.max())
+        skin = self.skin
+        reach = 2.0 * r_max + skin
+        cell = reach if self._cell_request is None else float(self._cell_request)
+        if cell < reach * (1 - 1e-12):
+            raise WheelsoilInputError(
+                f"cell_size = {cell!r} m is smaller than the interaction reach 2 r_max + skin = {reach:.4g} m"
+            )
+        extent = self.domain_max - self.domain_min
+        dims = np.maximum(1, np.ceil(extent / cell).astype(np.int64))
+        if int(np.prod(dims)) > 2**31 - 2:
+            raise WheelsoilInputError(f"neighbour grid of {dims.tolist()} cells is too large; raise cell_size")
+        width = neighbor_row_width(r_min, r_max, skin)
+        h = self._hist
+        if h is not None:
+            width = max(width, h["nbr"].shape[1])
+        mass = self.material.density * 4.0 / 3.0 * np.pi * self._r**3
+        d: dict = {
+            "n": n,
+            "r_min": r_min,
+            "skin": skin,
+            "cell": cell,
+            "dims": [int(v) for v in dims],
+            "width": width,
+            "e_eff": effective_modulus(self.material, self.material),
+            "g_eff": effective_shear_modulus(self.material, self.material),
+            "beta": self.pair.damping_ratio,
+        }
+
+        def vec(a):
+            arr = ti.Vector.ndarray(3, ti.f64, shape=max(len(a), 1))
+            if len(a):
+                arr.from_numpy(np.ascontiguousarray(a, dtype=np.float64))
+            return arr
+
+        def scal(a, dtype=ti.f64):
+            arr = ti.ndarray(dtype, shape=a.shape)
+            arr.from_numpy(np.ascontiguousarray(a))
+            return arr
+
+        d["x"], d["v"], d["w"] = vec(self._x), vec(self._v), vec(self._w)
+        d["f"], d["t"] = vec(self._f), vec(self._t)
+        d["x_ref"] = vec(self._x)
+        d["r"] = scal(self._r)
+        d["m"] = scal(mass)
+        d["I"] = scal(0.4 * mass * self._r**2)
+        n_cells = int(np.prod(dims))
+        d["cell_of"] = ti.ndarray(ti.i32, shape=n)
+        d["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
+        d["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
+        d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
+        self._alloc_rows(d, width)
+        if h is not None:
+            nb = np.zeros((n, width), np.int32)
+            nb[:, : h["nbr"].shape[1]] = h["nbr"]
+            xi = np.zeros((n, width, 3))
+            xi[:, : h["xi"].shape[1]] = h["xi"]
+            d["nbr"].from_numpy(nb)
+            d["count"].from_numpy(h["count"])
+            d["xi"].from_numpy(xi)
+        n_walls = len(self.walls)
+        d["wall_point"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
+        d["wall_normal"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
+        if n_walls:
+            d["wall_point"].from_numpy(np.array([w.point for w in self.walls], dtype=np.float64))
+            d["wall_normal"].from_numpy(np.array([w.normal for w in self.walls], dtype=np.float64))
+        props = np.zeros((max(n_walls, 1), 5))
+        for k, w in enumerate(self.walls):
+            props[k, forces.WALL_E_EFF] = effective_modulus(self.material, w.material)
+            props[k, forces.WALL_G_EFF] = effective_shear_modulus(self.material, w.material)
+            props[k, forces.WALL_BETA] = w.pair.damping_ratio
+            props[k, forces.WALL_MU_S] = w.pair.static_friction
+            props[k, forces.WALL_MU_R] = w.pair.rolling_friction
+        d["wall_props"] = scal(props)
+        d["xi_wall"] = ti.Vector.ndarray(3, ti.f64, shape=(n, max(n_walls, 1)))
+        if h is not None and n_walls:
+            d["xi_wall"].from_numpy(np.ascontiguousarray(h["xi_wall"]))
+        d["health"] = ti.ndarray(ti.f64, shape=4)
+        self._dev = d
+        self._rebuild_neighbors()
+        return d
+
+    @staticmethod
+    def _alloc_rows(d: dict, width: int) -> None:
+        n = d["n"]
+        d["width"] = width
+        for suffix in ("", "_new"):
+            d["nbr" + suffix] = ti.ndarray(ti.i32, shape=(n, width))
+            d["count" + suffix] = ti.ndarray(ti.i32, shape=n)
+            d["xi" + suffix] = ti.Vector.ndarray(3, ti.f64, shape=(n, width))
+        d["count"].fill(0)
+
+    def _rebuild_neighbors(self) -> None:
+        d = self._dev
+        origin = self.domain_min.tolist()
+        inv_cell = 1.0 / d["cell"]
+        neighbors.bin_particles(d["x"], origin, inv_cell, d["dims"], d["cell_of"], d["cell_count"])
+        neighbors.exclusive_scan(d["cell_count"], d["cell_start"])
+        neighbors.scatter_to_cells(d["cell_of"], d["cell_start"], d["cell_count"], d["sorted_ids"])
+        most = neighbors.build_neighbor_lists(
+            d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
+            d["nbr_new"], d["count_new"],
+        )
+        if most > d["width"]:
+            self._widen_rows(most + 4)
+            neighbors.build_neighbor_lists(
+                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
+                d["nbr_new"], d["count_new"],
+            )
+        neighbors.carry_history(d["nbr"], d["count"], d["xi"], d["nbr_new"], d["count_new"], d["xi_new"])
+        for key in ("nbr", "count", "xi"):
+            d[key], d[key + "_new"] = d[key + "_new"], d[key]
+        integrator.copy_vec3(d["x"], d["x_ref"])
+        self.neighbor_rebuilds += 1
+
+    def _widen_rows(self, width: int) -> None:
+        d = self._dev
+        if width > 4096:
+            raise CapacityError(f"a particle has {width} neighbours; the size ratio or skin is unreasonable")
+        old = {k: d[k].to_numpy() for k in ("nbr", "count", "xi")}
+        self._alloc_rows(d, width)
+        nb = np.zeros((d["n"], width), np.int32)
+        nb[:, : old["nbr"].shape[1]] = old["nbr"]
+        xi = np.zeros((d["n"], width, 3))
+        xi[:, : old["xi"].shape[1]] = old["xi"]
+        d["nbr"].from_numpy(nb)
+        d["count"].from_numpy(old["count"])
+        d["xi"].from_numpy(xi)
+
+    def _to_host(self) -> None:
+        """Copy the device state back to NumPy and drop the device arrays (before structural edits)."""
+        d = self._dev
+        if d is None:
+            return
+        self._x, self._v, self._w = d["x"].to_numpy(), d["v"].to_numpy(), d["w"].to_numpy()
+        self._f, self._t = d["f"].to_numpy(), d["t"].to_numpy()
+        self._hist = {
+            "nbr": d["nbr"].to_numpy(),
+            "count": d["count"].to_numpy(),
+            "xi": d["xi"].to_numpy(),
+            "xi_wall": d["xi_wall"].to_numpy()[:, : len(self.walls)],
+        }
+        self._dev = None
+
+    # ------------------------------------------------------------------ read-back
+    @property
+    def n_particles(self) -> int:
+        return int(self._r.shape[0])
+
+    def _read(self, key: str, host: np.ndarray) -> np.ndarray:
+        if self._dev is None:
+            return host.copy()
+        return self._dev[key].to_numpy()
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Sphere centres, (N, 3) [m]."""
+        return self._read("x", self._x)
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """Translational velocities, (N, 3) [m/s]."""
+        return self._read("v", self._v)
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        """Angular velocities, (N, 3) [rad/s]."""
+        return self._read("w", self._w)
+
+    @property
+    def radii(self) -> np.ndarray:
+        """Radii, (N,) [m]."""
+        return self._r.copy()
+
+    @property
+    def masses(self) -> np.ndarray:
+        """Masses, (N,) [kg]."""
+        return self.material.density * 4.0 / 3.0 * np.pi * self._r**3
+
+    @property
+    def contact_forces(self) -> np.ndarray:
+        """Sum of contact forces (particles and walls, no gravity) on each sphere, (N, 3) [N]."""
+        return self._read("f", self._f)
+
+    @property
+    def contact_torques(self) -> np.ndarray:
+        """Sum of contact torques about each sphere's centre, (N, 3) [N m]."""
+        return self._read("t", self._t)
+
+    @property
+    def contact_count(self) -> int:
+        """Number of touching pairs and particle--wall contacts after the last step."""
+        return int(self._n_contacts)
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy [J]."""
+        v, w, m = self.velocities, self.angular_velocities, self.masses
+        return float(0.5 * np.sum(m * np.sum(v * v, axis=1)) + 0.5 * np.sum(0.4 * m * self._r**2 * np.sum(w * w, axis=1)))
