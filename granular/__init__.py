@@ -9,6 +9,7 @@ Public API::
     BedSpec, prepare_bed, load_bed, Bed                 soil-bed preparation with an HDF5 cache
 """
 
+from .bed import Bed, BedNotSettledError, BedSpec, load_bed, prepare_bed
 from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
 from .materials import (
     LUNAR_SOIL_SIMULANT,
@@ -28,6 +29,11 @@ from .scene import Scene, Wall
 from .timestep import TimeStepEstimate, estimate_time_step
 
 __all__ = [
+    "Bed",
+    "BedNotSettledError",
+    "BedSpec",
+    "load_bed",
+    "prepare_bed",
     "CapacityError",
     "LUNAR_SOIL_SIMULANT",
     "Material",

@@ -62,7 +62,7 @@ def _as_array(name: str, value, shape_tail: tuple[int, ...], n: int | None = Non
     if bad.any():
         idx = np.argwhere(bad)[0]
         raise WheelsoilInputError(
-            f"{name} contains a non-finite value {arr[tuple(idx)]!r} at index {tuple(int(i) for i in idx)}"
+            f"{name} contains a non-finite value {float(arr[tuple(idx)])!r} at index {tuple(int(i) for i in idx)}"
         )
     return np.ascontiguousarray(arr)
 
@@ -223,7 +223,7 @@ class Scene:
             raise WheelsoilInputError(f"radii = {radii!r} must be finite")
         bad = np.flatnonzero(r <= 0.0)
         if bad.size:
-            raise WheelsoilInputError(f"radius {r[bad[0]]!r} m of sphere {int(bad[0])} is invalid: radii must be > 0")
+            raise WheelsoilInputError(f"radius {float(r[bad[0]])!r} m of sphere {int(bad[0])} is invalid: radii must be > 0")
         v = np.zeros((n, 3)) if velocities is None else _as_array("velocities", velocities, (3,), n)
         w = np.zeros((n, 3)) if angular_velocities is None else _as_array("angular_velocities", angular_velocities, (3,), n)
         outside = np.flatnonzero(np.any((x < self.domain_min) | (x > self.domain_max), axis=1))

@@ -1,0 +1,180 @@
+"""The ``wheelsoil`` command line.
+
+Exit codes (scripts can trust them):
+    0  success
+    1  unexpected internal error (a bug: please report it with the traceback)
+    2  bad input (a parameter out of range, a missing file); the message names the value
+    3  the simulation went unstable or did not settle; nothing was written
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE = 0, 1, 2, 3
+
+GRAVITY_PRESETS = {"earth": 9.81, "moon": 9.81 / 6.0}
+
+MAIN_HELP = """\
+wheelsoil: a single-wheel terramechanics testbed in software.
+
+Start with the smoke job (a small regolith bed, settled under Earth gravity, saved to HDF5 and
+rendered to PNG):
+
+    wheelsoil run
+
+then prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
+
+    wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --gravity moon --out moon_bed.h5
+    wheelsoil render moon_bed.h5 --out moon_bed.png
+"""
+
+
+def _gravity(value: str) -> float:
+    if value in GRAVITY_PRESETS:
+        return GRAVITY_PRESETS[value]
+    try:
+        g = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"gravity {value!r} is neither a preset {sorted(GRAVITY_PRESETS)} nor a number in m/s^2"
+        ) from None
+    if not (0 < g < 1000):
+        raise argparse.ArgumentTypeError(f"gravity {g} m/s^2 must lie in (0, 1000)")
+    return g
+
+
+def _add_bed_options(p: argparse.ArgumentParser, *, length=0.5, width=0.25, depth=0.1) -> None:
+    g = p.add_argument_group("soil bed")
+    g.add_argument("--length", type=float, default=length, help=f"bin length along x [m] (default {length})")
+    g.add_argument("--width", type=float, default=width, help=f"bin width along y [m] (default {width})")
+    g.add_argument("--depth", type=float, default=depth, help=f"levelled bed depth [m] (default {depth})")
+    g.add_argument("--dmin", type=float, default=0.016, help="smallest particle diameter [m] (default 0.016, seed 004)")
+    g.add_argument("--dmax", type=float, default=0.024, help="largest particle diameter [m] (default 0.024, seed 004)")
+    g.add_argument("--gravity", type=_gravity, default=GRAVITY_PRESETS["earth"],
+                   help="'earth' (9.81), 'moon' (9.81/6) or a value in m/s^2 (default earth); "
+                        "beds are prepared under the gravity they are tested at")
+    g.add_argument("--seed", type=int, default=0, help="random seed of radii and packing (default 0)")
+    g.add_argument("--no-cache", action="store_true", help="prepare afresh even if an identical bed is cached")
+    p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
+
+
+def _spec_from_args(args):
+    from wheelsoil.granular import BedSpec
+
+    return BedSpec(length=args.length, width=args.width, depth=args.depth, diameter_min=args.dmin,
+                   diameter_max=args.dmax, gravity=(0.0, 0.0, -args.gravity), seed=args.seed)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="wheelsoil", description=MAIN_HELP,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    from wheelsoil import __version__
+
+    parser.add_argument("--version", action="version", version=f"wheelsoil {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("run", help="run the embedded smoke job (prepare a small bed, save HDF5, render PNG)",
+                       description="Run the embedded smoke job: prepare a small regolith bed under the chosen "
+                                   "gravity (cached), write it to OUT/bed.h5 and render OUT/bed.png offscreen.")
+    _add_bed_options(p)
+    p.add_argument("--out", type=Path, default=Path("wheelsoil-output"), help="output folder (default wheelsoil-output)")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin; write it to HDF5",
+                       description="Fill a bin with polydisperse spheres, settle under gravity until the kinetic "
+                                   "energy per particle is below the threshold, level at the target depth, and "
+                                   "write the bed to HDF5. Identical beds are reused from the cache "
+                                   "(WHEELSOIL_CACHE, default ~/.cache/wheelsoil).")
+    _add_bed_options(p)
+    p.add_argument("--out", type=Path, default=Path("bed.h5"), help="bed file to write (default bed.h5)")
+    p.set_defaults(func=cmd_prepare_bed)
+
+    p = sub.add_parser("render", help="render a bed file to PNG offscreen",
+                       description="Render the particles of a bed HDF5 file to a PNG, coloured by height.")
+    p.add_argument("bed", type=Path, help="bed file written by prepare-bed or run")
+    p.add_argument("--out", type=Path, default=None, help="PNG to write (default: next to the bed file)")
+    p.add_argument("--camera", default="iso", help="camera preset: iso, side, top, front (default iso)")
+    p.add_argument("--size", type=int, nargs=2, default=(1200, 800), metavar=("W", "H"), help="image size in pixels")
+    p.set_defaults(func=cmd_render)
+    return parser
+
+
+def _console():
+    from rich.console import Console
+
+    return Console(stderr=False)
+
+
+def _prepare(args, console):
+    from wheelsoil.granular import prepare_bed
+
+    spec = _spec_from_args(args)
+    bed = prepare_bed(spec, use_cache=not args.no_cache, progress=console.is_terminal, arch=args.arch)
+    origin = "reused from cache" if bed.meta.get("from_cache") else f"prepared in {bed.meta['prepare_seconds']:.1f} s"
+    console.print(f"[bold]{bed.summary()}[/bold] ({origin})")
+    return bed
+
+
+def cmd_run(args) -> int:
+    from .render import render_bed
+
+    console = _console()
+    bed = _prepare(args, console)
+    out = Path(args.out)
+    h5 = bed.save(out / "bed.h5")
+    png = render_bed(bed, out / "bed.png")
+    console.print(f"wrote {h5} and {png}")
+    return EXIT_OK
+
+
+def cmd_prepare_bed(args) -> int:
+    console = _console()
+    bed = _prepare(args, console)
+    console.print(f"wrote {bed.save(args.out)}")
+    return EXIT_OK
+
+
+def cmd_render(args) -> int:
+    from wheelsoil.granular import load_bed
+
+    from .render import CAMERA_PRESETS, render_bed
+
+    if args.camera not in CAMERA_PRESETS:
+        raise _InputError(f"--camera {args.camera!r} is not a preset; choose one of {sorted(CAMERA_PRESETS)}")
+    bed = load_bed(args.bed)
+    out = args.out or args.bed.with_suffix(".png")
+    console = _console()
+    console.print(f"wrote {render_bed(bed, out, camera=args.camera, size=tuple(args.size))}")
+    return EXIT_OK
+
+
+class _InputError(ValueError):
+    pass
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return EXIT_INPUT
+    from wheelsoil.granular import SimulationUnstableError, WheelsoilInputError
+
+    try:
+        return args.func(args)
+    except (WheelsoilInputError, _InputError) as exc:
+        print(f"wheelsoil {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except SimulationUnstableError as exc:
+        print(f"wheelsoil {args.command}: simulation stopped: {exc}", file=sys.stderr)
+        return EXIT_UNSTABLE
+    except KeyboardInterrupt:
+        print(f"wheelsoil {args.command}: interrupted; nothing partial was written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

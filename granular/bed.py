@@ -1,0 +1,410 @@
+"""Soil-bed preparation: fill a bin, settle under the test gravity, level, measure, cache as HDF5.
+
+Protocol (as a lab prepares a soil bin, and as seed 004 section 2.3 prepares its DEM bin):
+
+1. *Fill*: polydisperse spheres (diameters uniform in [d_min, d_max]) on a jittered loose lattice
+   above the bin floor, enough for ``overfill`` times the target depth at packing fraction 0.6.
+2. *Settle* under the gravity the bed will be tested at, until the kinetic energy per particle
+   falls below a threshold (default: that of the mean particle moving at 5 mm/s).
+3. *Level*: remove every sphere whose centre lies above the target height, then settle again.
+4. *Measure*: surface height (mean over d_max-wide columns of the highest sphere top) and the bulk
+   packing fraction in a core region one d_max away from the walls, floor and surface.
+
+The result is cached under a key made from every parameter that shapes the bed; preparing the same
+bed again loads the file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from wheelsoil.provenance import atomic_output, provenance
+
+from . import runtime
+from .errors import SimulationUnstableError, WheelsoilInputError
+from .materials import LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL, Material, PairProperties
+from .scene import Scene
+
+#: Bump when the preparation protocol changes so that stale caches are not reused.
+BED_FORMAT_VERSION = 1
+
+
+class BedNotSettledError(SimulationUnstableError):
+    """The bed did not come to rest within the allowed simulated time."""
+
+
+@dataclass(frozen=True)
+class BedSpec:
+    """Everything that shapes a prepared soil bed (SI units).
+
+    Attributes
+    ----------
+    length, width: bin size along x and y [m].
+    depth: target height of the levelled surface above the floor [m].
+    diameter_min, diameter_max: particle diameter range [m], uniform distribution.
+    gravity: gravity vector the bed is prepared (and will be tested) under [m/s^2].
+    material, pair: particle material and soil--soil pair properties.
+    wall_material, wall_pair: bin walls (``wall_material=None`` is rigid) and soil--wall pair.
+    seed: random seed of radii and lattice jitter.
+    kinetic_energy_threshold: settled when the kinetic energy per particle is below this [J];
+        ``None``: 0.5 m_mean (5 mm/s)^2.
+    max_settle_time: give up (error) after this much simulated time per settling phase [s].
+    overfill: particles for ``overfill`` x the target depth, so levelling has some to remove.
+    time_step: DEM time step [s]; ``None`` uses the stable estimate.
+    """
+
+    length: float = 0.5
+    width: float = 0.25
+    depth: float = 0.1
+    diameter_min: float = 0.016
+    diameter_max: float = 0.024
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    material: Material = LUNAR_SOIL_SIMULANT
+    pair: PairProperties = SOIL_SOIL
+    wall_material: Material | None = STEEL
+    wall_pair: PairProperties = SOIL_STEEL
+    seed: int = 0
+    kinetic_energy_threshold: float | None = None
+    max_settle_time: float = 10.0
+    overfill: float = 1.15
+    time_step: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("length", "width", "depth", "diameter_min", "diameter_max", "max_settle_time"):
+            value = float(getattr(self, name))
+            if not (math.isfinite(value) and value > 0):
+                raise WheelsoilInputError(f"bed {name} = {value!r} is invalid: it must be a finite number > 0")
+        if self.diameter_max < self.diameter_min:
+            raise WheelsoilInputError(
+                f"bed diameter_max = {self.diameter_max!r} m is smaller than diameter_min = {self.diameter_min!r} m"
+            )
+        g = tuple(float(v) for v in self.gravity)
+        if len(g) != 3 or not all(math.isfinite(v) for v in g) or g[2] >= 0.0:
+            raise WheelsoilInputError(
+                f"bed gravity = {self.gravity!r} is invalid: it must be a finite 3-vector pointing down (g_z < 0)"
+            )
+        object.__setattr__(self, "gravity", g)
+        smallest = min(self.length, self.width)
+        if self.diameter_max * 3 > smallest:
+            raise WheelsoilInputError(
+                f"bed of {self.length} x {self.width} m is too narrow for particles of diameter "
+                f"{self.diameter_max} m: each side must hold at least 3 of the largest particles"
+            )
+        if self.depth < 2 * self.diameter_max:
+            raise WheelsoilInputError(
+                f"bed depth = {self.depth} m must be at least two of the largest particles ({2 * self.diameter_max} m)"
+            )
+        if not (1.0 <= self.overfill <= 3.0):
+            raise WheelsoilInputError(f"bed overfill = {self.overfill!r} must lie in [1, 3]")
+        if self.kinetic_energy_threshold is not None and not (self.kinetic_energy_threshold > 0):
+            raise WheelsoilInputError(
+                f"bed kinetic_energy_threshold = {self.kinetic_energy_threshold!r} J must be > 0"
+            )
+        if self.time_step is not None and not (self.time_step > 0):
+            raise WheelsoilInputError(f"bed time_step = {self.time_step!r} s must be > 0")
+
+    # ---------------------------------------------------------------- derived quantities
+    @property
+    def gravity_magnitude(self) -> float:
+        return float(np.linalg.norm(self.gravity))
+
+    @property
+    def mean_particle_volume(self) -> float:
+        """E[pi d^3 / 6] for d uniform in [d_min, d_max] [m^3]."""
+        a, b = self.diameter_min, self.diameter_max
+        mean_d3 = a**3 if b == a else (b**4 - a**4) / (4.0 * (b - a))
+        return math.pi / 6.0 * mean_d3
+
+    @property
+    def settle_threshold(self) -> float:
+        """Kinetic energy per particle below which the bed counts as settled [J]."""
+        if self.kinetic_energy_threshold is not None:
+            return float(self.kinetic_energy_threshold)
+        return 0.5 * self.material.density * self.mean_particle_volume * 0.005**2
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["gravity"] = list(self.gravity)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> BedSpec:
+        d = dict(d)
+        d["material"] = Material(**d["material"])
+        d["pair"] = PairProperties(**d["pair"])
+        d["wall_material"] = None if d.get("wall_material") is None else Material(**d["wall_material"])
+        d["wall_pair"] = PairProperties(**d["wall_pair"])
+        d["gravity"] = tuple(d["gravity"])
+        return cls(**d)
+
+    def cache_key(self) -> str:
+        """SHA-256 over every parameter that shapes the bed and the protocol version."""
+        payload = json.dumps({"format": BED_FORMAT_VERSION, "spec": self.to_dict()}, sort_keys=True)
+        return hashlib.sha256(payload.encode()).hexdigest()
+
+
+@dataclass
+class Bed:
+    """A prepared soil bed: settled sphere state plus what was measured about it."""
+
+    spec: BedSpec
+    positions: np.ndarray
+    radii: np.ndarray
+    velocities: np.ndarray
+    angular_velocities: np.ndarray
+    surface_height: float
+    packing_fraction: float
+    settle_time: float
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def n_particles(self) -> int:
+        return int(self.radii.shape[0])
+
+    def summary(self) -> str:
+        s = self.spec
+        g = s.gravity_magnitude
+        return (
+            f"bed {s.length:g} x {s.width:g} m, {self.n_particles} particles of {1e3 * s.diameter_min:g}-"
+            f"{1e3 * s.diameter_max:g} mm at g = {g:.3g} m/s^2: surface {self.surface_height:.4f} m "
+            f"(target {s.depth:g} m), packing fraction {self.packing_fraction:.3f}, "
+            f"settled in {self.settle_time:.2f} s simulated"
+        )
+
+    # ---------------------------------------------------------------- persistence
+    def save(self, path: str | Path) -> Path:
+        """Write the bed to HDF5 atomically; returns the path."""
+        path = Path(path)
+        with atomic_output(path) as tmp, h5py.File(tmp, "w") as f:
+            grp = f.create_group("particles")
+            grp.create_dataset("position", data=self.positions).attrs["units"] = "m"
+            grp.create_dataset("velocity", data=self.velocities).attrs["units"] = "m/s"
+            grp.create_dataset("angular_velocity", data=self.angular_velocities).attrs["units"] = "rad/s"
+            grp.create_dataset("radius", data=self.radii).attrs["units"] = "m"
+            f.attrs["kind"] = "wheelsoil soil bed"
+            f.attrs["bed_format"] = BED_FORMAT_VERSION
+            f.attrs["spec"] = json.dumps(self.spec.to_dict(), sort_keys=True)
+            f.attrs["cache_key"] = self.spec.cache_key()
+            f.attrs["surface_height"] = self.surface_height
+            f.attrs["packing_fraction"] = self.packing_fraction
+            f.attrs["settle_time"] = self.settle_time
+            f.attrs["seed"] = self.spec.seed
+            for k, v in {**provenance(), **self.meta}.items():
+                f.attrs[k] = v
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Bed:
+        """Read a bed written by :meth:`save`."""
+        path = Path(path)
+        if not path.is_file():
+            raise WheelsoilInputError(f"bed file {str(path)!r} does not exist")
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("kind") != "wheelsoil soil bed":
+                raise WheelsoilInputError(f"{str(path)!r} is not a wheelsoil soil-bed file")
+            p = f["particles"]
+            meta = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+            return cls(
+                spec=BedSpec.from_dict(json.loads(f.attrs["spec"])),
+                positions=p["position"][...],
+                radii=p["radius"][...],
+                velocities=p["velocity"][...],
+                angular_velocities=p["angular_velocity"][...],
+                surface_height=float(f.attrs["surface_height"]),
+                packing_fraction=float(f.attrs["packing_fraction"]),
+                settle_time=float(f.attrs["settle_time"]),
+                meta={k: meta[k] for k in ("version", "git_rev", "taichi_version", "arch", "created") if k in meta},
+            )
+
+    def to_scene(self, *, headroom: float | None = None, arch: str | None = None, **scene_kwargs) -> Scene:
+        """A :class:`Scene` holding this bed in its bin (floor and four side walls).
+
+        ``headroom`` [m] extends the domain above the surface (default: the bed depth, at least
+        0.1 m). Contact history starts afresh; the bed is at rest, so it re-seats within a few steps.
+        """
+        s = self.spec
+        top = self.surface_height + (headroom if headroom is not None else max(s.depth, 0.1))
+        scene = Scene(
+            (0.0, 0.0, 0.0), (s.length, s.width, top),
+            gravity=s.gravity, material=s.material, pair=s.pair, arch=arch, **scene_kwargs,
+        )
+        scene.add_box_walls(material=s.wall_material, pair=s.wall_pair)
+        scene.add_spheres(self.positions, self.radii, self.velocities, self.angular_velocities)
+        if s.time_step is not None:
+            scene.time_step = s.time_step
+        return scene
+
+
+# ---------------------------------------------------------------------- preparation
+def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
+    """Jittered loose lattice of spheres filling the bin; returns positions, radii, fill-top height."""
+    rng = np.random.default_rng(spec.seed)
+    r_max = 0.5 * spec.diameter_max
+    spacing = spec.diameter_max * 1.05
+    nx = int((spec.length - 2 * r_max) // spacing) + 1
+    ny = int((spec.width - 2 * r_max) // spacing) + 1
+    needed = spec.overfill * 0.6 * spec.length * spec.width * spec.depth / spec.mean_particle_volume
+    layers = max(2, int(math.ceil(needed / (nx * ny))))
+    ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(layers), indexing="ij")
+    # centre the lattice in the bin
+    x0 = 0.5 * (spec.length - (nx - 1) * spacing)
+    y0 = 0.5 * (spec.width - (ny - 1) * spacing)
+    pos = np.stack([x0 + ix * spacing, y0 + iy * spacing, r_max * 1.05 + iz * spacing], -1).reshape(-1, 3)
+    # order layer by layer (bottom first) so that the removed excess is at the top
+    pos = pos[np.lexsort((pos[:, 0], pos[:, 1], pos[:, 2]))]
+    diam = rng.uniform(spec.diameter_min, spec.diameter_max, len(pos))
+    slack = 0.5 * (spacing - diam)[:, None] * 0.9
+    pos = pos + rng.uniform(-1.0, 1.0, pos.shape) * slack
+    return pos, 0.5 * diam, float(pos[:, 2].max() + r_max)
+
+
+def measure_surface(positions: np.ndarray, radii: np.ndarray, spec: BedSpec) -> float:
+    """Mean over d_max-wide columns (away from the walls) of the highest sphere top [m]."""
+    d = spec.diameter_max
+    nx = max(1, int((spec.length - 2 * d) // d))
+    ny = max(1, int((spec.width - 2 * d) // d))
+    ix = np.floor((positions[:, 0] - d) / d).astype(int)
+    iy = np.floor((positions[:, 1] - d) / d).astype(int)
+    inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+    tops = np.full(nx * ny, -np.inf)
+    np.maximum.at(tops, ix[inside] * ny + iy[inside], (positions[:, 2] + radii)[inside])
+    tops = tops[np.isfinite(tops)]
+    return float(tops.mean()) if tops.size else float((positions[:, 2] + radii).max())
+
+
+def measure_packing_fraction(positions: np.ndarray, radii: np.ndarray, spec: BedSpec, surface: float) -> float:
+    """Solid volume fraction in the core region [d_max, L - d_max] x [d_max, W - d_max] x [d_max, surface - d_max],
+    counting each sphere whose centre lies inside (unbiased for a region much larger than a sphere)."""
+    d = spec.diameter_max
+    lo = np.array([d, d, d])
+    hi = np.array([spec.length - d, spec.width - d, surface - d])
+    if np.any(hi <= lo):
+        lo, hi = np.zeros(3), np.array([spec.length, spec.width, surface])
+    inside = np.all((positions >= lo) & (positions <= hi), axis=1)
+    return float(np.sum(4.0 / 3.0 * np.pi * radii[inside] ** 3) / np.prod(hi - lo))
+
+
+def settle(scene: Scene, spec: BedSpec, *, label: str, min_time: float = 0.0, progress=None) -> float:
+    """Step until the kinetic energy per particle is below ``spec.settle_threshold``; return the time taken."""
+    threshold = spec.settle_threshold
+    start = scene.time
+    chunk = max(1, int(round(0.01 / scene.time_step)))  # check every 10 ms of simulated time
+    task = progress.add_task(label, total=None) if progress is not None else None
+    while True:
+        scene.step(chunk)
+        health = scene.check_health()
+        per_particle = health["kinetic_energy"] / scene.n_particles
+        elapsed = scene.time - start
+        if progress is not None:
+            progress.update(
+                task, description=f"{label}: t = {elapsed:.2f} s, KE/particle = {per_particle:.2e} J "
+                f"(target {threshold:.1e} J)"
+            )
+        if per_particle < threshold and elapsed >= min_time:
+            break
+        if elapsed > spec.max_settle_time:
+            raise BedNotSettledError(
+                f"{label}: the bed did not settle within max_settle_time = {spec.max_settle_time} s "
+                f"(kinetic energy per particle {per_particle:.3e} J, threshold {threshold:.3e} J); "
+                "raise max_settle_time or kinetic_energy_threshold"
+            )
+    if progress is not None:
+        progress.remove_task(task)
+    return scene.time - start
+
+
+def default_bed_cache() -> Path:
+    return runtime.default_cache_dir() / "beds"
+
+
+def bed_cache_path(spec: BedSpec, cache_dir: str | Path | None = None) -> Path:
+    folder = Path(cache_dir) if cache_dir is not None else default_bed_cache()
+    return folder / f"bed-{spec.cache_key()[:20]}.h5"
+
+
+def prepare_bed(
+    spec: BedSpec | None = None,
+    *,
+    cache_dir: str | Path | None = None,
+    use_cache: bool = True,
+    progress: bool = False,
+    arch: str | None = None,
+) -> Bed:
+    """Prepare (or load from the cache) the soil bed described by ``spec``.
+
+    Returns a :class:`Bed`; ``bed.meta["cache_path"]`` is the cached file, ``bed.meta["from_cache"]``
+    tells whether it was reused.
+    """
+    spec = spec or BedSpec()
+    path = bed_cache_path(spec, cache_dir)
+    if use_cache and path.is_file():
+        bed = Bed.load(path)
+        bed.meta.update(cache_path=str(path), from_cache=True)
+        return bed
+
+    runtime.init(arch)
+    wall_clock = time.perf_counter()
+    positions, radii, fill_top = initial_packing(spec)
+    scene = Scene(
+        (0.0, 0.0, 0.0),
+        (spec.length, spec.width, max(fill_top, spec.depth) + spec.diameter_max * 2),
+        gravity=spec.gravity, material=spec.material, pair=spec.pair, arch=arch,
+        impact_speed=max(1.0, math.sqrt(2 * spec.gravity_magnitude * fill_top)),
+    )
+    scene.add_box_walls(material=spec.wall_material, pair=spec.wall_pair)
+    scene.add_spheres(positions, radii)
+    if spec.time_step is not None:
+        scene.time_step = spec.time_step
+    fall_time = math.sqrt(2.0 * fill_top / spec.gravity_magnitude)
+
+    bar = None
+    if progress:
+        from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), transient=True)
+        bar.start()
+    try:
+        t_settle = settle(scene, spec, label="settling", min_time=fall_time, progress=bar)
+        x = scene.positions
+        filled = measure_surface(x, scene.radii, spec)
+        if filled < spec.depth:
+            raise WheelsoilInputError(
+                f"the settled fill reaches only {filled:.4f} m, below the target depth {spec.depth} m; "
+                f"raise overfill (now {spec.overfill})"
+            )
+        scene.keep_spheres(x[:, 2] <= spec.depth)
+        t_level = settle(scene, spec, label="levelled, re-settling", progress=bar)
+    finally:
+        if bar is not None:
+            bar.stop()
+    x, r = scene.positions, scene.radii
+    surface = measure_surface(x, r, spec)
+    bed = Bed(
+        spec=spec,
+        positions=x,
+        radii=r,
+        velocities=scene.velocities,
+        angular_velocities=scene.angular_velocities,
+        surface_height=surface,
+        packing_fraction=measure_packing_fraction(x, r, spec, surface),
+        settle_time=t_settle + t_level,
+        meta={"prepare_seconds": time.perf_counter() - wall_clock, "time_step": scene.time_step},
+    )
+    if use_cache:
+        bed.save(path)
+    bed.meta.update(cache_path=str(path) if use_cache else "", from_cache=False)
+    return bed
+
+
+def load_bed(path: str | Path) -> Bed:
+    """Read a bed HDF5 file (see :meth:`Bed.save`)."""
+    return Bed.load(path)
