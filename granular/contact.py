@@ -52,7 +52,6 @@ def hertz_mindlin(
     overlap: ti.f64,
     v_rel: vec3,
     omega_rel: vec3,
-    arm: ti.f64,
     r_eff: ti.f64,
     m_eff: ti.f64,
     inertia_eff: ti.f64,
@@ -64,49 +63,51 @@ def hertz_mindlin(
     xi: vec3,
     dt: ti.f64,
 ):
-    """Force on body *i* [N], torque on *i* about its centre [N m] and the updated history xi [m].
+    """Contact force on body *i* and the pieces of the torques; returns ``(force, n_cross_ft, m_roll, xi)``.
+
+    * ``force`` [N] acts on *i* (the partner receives ``-force``);
+    * ``n_cross_ft`` = n x F_t [N]: the tangential force's torque on a body is ``arm * n_cross_ft``
+      for *i* and for the partner alike (``arm`` = distance from the body's centre to the contact);
+    * ``m_roll`` [N m] is the rolling-resistance torque on *i* (the partner receives ``-m_roll``);
+    * ``xi`` [m] is the updated tangential history.
 
     Parameters (SI units): ``n`` unit normal from *i* to the partner; ``overlap`` delta_n > 0 [m];
     ``v_rel`` contact-point velocity of *i* relative to the partner [m/s]; ``omega_rel`` angular
-    velocity of *i* minus that of the partner [rad/s]; ``arm`` distance from *i*'s centre to the
-    contact point [m]; ``r_eff``, ``m_eff``, ``inertia_eff`` R*, m*, I* [m, kg, kg m^2]; ``e_eff``,
-    ``g_eff`` E*, G* [Pa]; ``beta`` damping ratio (eq. 9, >= 0); ``mu_s``, ``mu_r`` friction
-    coefficients; ``xi`` tangential displacement history [m]; ``dt`` time step [s].
+    velocity of *i* minus that of the partner [rad/s]; ``r_eff``, ``m_eff``, ``inertia_eff`` R*, m*,
+    I* [m, kg, kg m^2]; ``e_eff``, ``g_eff`` E*, G* [Pa]; ``beta`` damping ratio (eq. 9, >= 0);
+    ``mu_s``, ``mu_r`` friction coefficients; ``xi`` tangential history [m]; ``dt`` time step [s].
     """
     sqrt_rd = ti.sqrt(r_eff * overlap)
     f_elastic = (4.0 / 3.0) * e_eff * sqrt_rd * overlap  # eq. 3
     s_n = 2.0 * e_eff * sqrt_rd
     s_t = 8.0 * g_eff * sqrt_rd  # eq. 8
     gamma_n = DAMPING_PREFACTOR * beta * ti.sqrt(s_n * m_eff)  # eq. 5
-    gamma_t = DAMPING_PREFACTOR * beta * ti.sqrt(s_t * m_eff)  # eq. 6
+    gamma_t = gamma_n * ti.sqrt(4.0 * g_eff / e_eff)  # eq. 6: sqrt(S_t m*) = sqrt(S_n m*) sqrt(S_t / S_n)
 
     v_n = v_rel.dot(n)
     f_normal = f_elastic + gamma_n * v_n  # magnitude along -n (repulsive when > 0)
     v_t = v_rel - v_n * n
 
     # Carry the history into the current tangent plane, keeping its length.
-    xi_len = xi.norm()
     xi_t = xi - xi.dot(n) * n
-    xi_t_len = xi_t.norm()
-    if xi_t_len > 0.0:
-        xi_t = xi_t * (xi_len / xi_t_len)
+    xi_t_len2 = xi_t.norm_sqr()
+    if xi_t_len2 > 0.0:
+        xi_t = xi_t * ti.sqrt(xi.norm_sqr() / xi_t_len2)
     xi_t += v_t * dt
 
     f_t = -s_t * xi_t - gamma_t * v_t  # eqs. 4 and 6
-    f_t_len = f_t.norm()
+    f_t_len2 = f_t.norm_sqr()
     f_t_max = mu_s * f_elastic
-    if f_t_len > f_t_max:
-        f_t = f_t * (f_t_max / f_t_len)
+    if f_t_len2 > f_t_max * f_t_max:
+        f_t = f_t * (f_t_max / ti.sqrt(f_t_len2))
         if s_t > 0.0:
             xi_t = -f_t / s_t
 
-    force = -f_normal * n + f_t
-    torque = arm * n.cross(f_t)
-
     # Rolling resistance of the constant-directional-torque type.
+    m_roll = vec3(0.0, 0.0, 0.0)
     omega_r = omega_rel - omega_rel.dot(n) * n
     omega_r_len = omega_r.norm()
     if omega_r_len > 0.0:
-        m_roll = ti.min(mu_r * ti.abs(f_elastic) * r_eff, inertia_eff * omega_r_len / dt)
-        torque -= m_roll * (omega_r / omega_r_len)
-    return force, torque, xi_t
+        magnitude = ti.min(mu_r * f_elastic * r_eff, inertia_eff * omega_r_len / dt)
+        m_roll = -(magnitude / omega_r_len) * omega_r
+    return -f_normal * n + f_t, n.cross(f_t), m_roll, xi_t

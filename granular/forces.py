@@ -1,7 +1,10 @@
 """Contact-force kernel: gathers, for every particle, the Hertz--Mindlin forces of its partners and walls.
 
-Each particle sums the forces that act on it (a gather, no floating-point atomics); the two
-evaluations of a pair are exact mirror images (see :mod:`.contact`), so action equals reaction.
+Each particle sums the forces that act on it (a gather: no floating-point atomics, no scatter), so
+every pair is evaluated from both sides; the two evaluations are mirror images (see
+:mod:`.contact`), so action equals reaction to round-off. A two-pass variant that evaluates each
+pair once, stores the result per slot and gathers it through a mirror index was measured slower on
+CPU (benchmarks/README.md): the extra slot traffic costs more than the halved arithmetic.
 """
 
 
@@ -67,13 +70,12 @@ def contact_forces(
                 ij = inertia[j]
                 surf_i = vi + wi.cross(ri * n)
                 surf_j = v[j] + omega[j].cross(-rj * n)
-                fc, tc, xi_new = hertz_mindlin(
+                fc, tn, m_roll, xi_new = hertz_mindlin(
                     n,
                     reach - dist,
                     surf_i - surf_j,
                     wi - omega[j],
-                    ri,
-                    ri * rj / (ri + rj),
+                    ri * rj / reach,
                     mi * mj / (mi + mj),
                     ii * ij / (ii + ij),
                     e_eff,
@@ -86,7 +88,7 @@ def contact_forces(
                 )
                 xi[i, k] = xi_new
                 f += fc
-                t += tc
+                t += ri * tn + m_roll
                 if i < j:
                     n_contacts += 1
             else:
@@ -96,12 +98,11 @@ def contact_forces(
             gap = (xi_pos - wall_point[w]).dot(nw)
             if gap < ri:
                 n = -nw
-                fc, tc, xi_new = hertz_mindlin(
+                fc, tn, m_roll, xi_new = hertz_mindlin(
                     n,
                     ri - gap,
                     vi + wi.cross(ri * n),
                     wi,
-                    ri,
                     ri,
                     mi,
                     ii,
@@ -115,7 +116,7 @@ def contact_forces(
                 )
                 xi_wall[i, w] = xi_new
                 f += fc
-                t += tc
+                t += ri * tn + m_roll
                 n_contacts += 1
             else:
                 xi_wall[i, w] = vec3(0.0, 0.0, 0.0)

@@ -503,8 +503,10 @@ class Scene:
             d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
             d["nbr_new"], d["count_new"],
         )
-        if most > d["width"]:
-            self._widen_rows(most + 4)
+        fitted = most + max(4, most // 4)
+        if most > d["width"] or 2 * fitted < d["width"]:
+            # Rows too narrow, or far wider than needed (wide rows waste cache): refit them.
+            self._refit_rows(fitted)
             neighbors.build_neighbor_lists(
                 d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
                 d["nbr_new"], d["count_new"],
@@ -515,16 +517,18 @@ class Scene:
         integrator.copy_vec3(d["x"], d["x_ref"])
         self.neighbor_rebuilds += 1
 
-    def _widen_rows(self, width: int) -> None:
+    def _refit_rows(self, width: int) -> None:
         d = self._dev
         if width > 4096:
             raise CapacityError(f"a particle has {width} neighbours; the size ratio or skin is unreasonable")
         old = {k: d[k].to_numpy() for k in ("nbr", "count", "xi")}
+        width = max(width, int(old["count"].max(initial=0)))  # the old rows' history must fit too
+        keep = min(width, old["nbr"].shape[1])
         self._alloc_rows(d, width)
         nb = np.zeros((d["n"], width), np.int32)
-        nb[:, : old["nbr"].shape[1]] = old["nbr"]
+        nb[:, :keep] = old["nbr"][:, :keep]
         xi = np.zeros((d["n"], width, 3))
-        xi[:, : old["xi"].shape[1]] = old["xi"]
+        xi[:, :keep] = old["xi"][:, :keep]
         d["nbr"].from_numpy(nb)
         d["count"].from_numpy(old["count"])
         d["xi"].from_numpy(xi)
