@@ -2,6 +2,7 @@
 
 Usage (full tier; see benchmarks/README.md)::
 
+    wheelsoil bench                                          # = python benchmarks/dem_throughput.py
     python benchmarks/dem_throughput.py                      # >= 50k-particle bed, both codes
     python benchmarks/dem_throughput.py --no-liggghts        # wheelsoil only
     python benchmarks/dem_throughput.py --memory-check       # seed-004 bed size (388,026 particles)
@@ -24,9 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import re
-import resource
 import shutil
 import subprocess
 import sys
@@ -36,11 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.benchmarks.common import compile_time_cold, machine, peak_rss_mib, versions
+
 HERE = Path(__file__).resolve().parent
-
-
-def peak_rss_mib() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def bench_spec(args):
@@ -51,29 +48,6 @@ def bench_spec(args):
         diameter_min=0.016, diameter_max=0.024, gravity=(0.0, 0.0, -9.81),
         wall_material=LUNAR_SOIL_SIMULANT, wall_pair=SOIL_SOIL, seed=1,
     )
-
-
-def compile_time_cold() -> dict:
-    """Time to the end of the first step of a small scene in a fresh process with an empty kernel cache."""
-    code = (
-        "import time; t0=time.perf_counter();"
-        "import numpy as np; from wheelsoil.granular import Scene, runtime;"
-        "runtime.init(); t1=time.perf_counter();"
-        "s=Scene((0,0,0),(0.2,0.2,0.2)); s.add_box_walls();"
-        "s.add_spheres(np.array([[0.1,0.1,0.05],[0.1,0.1,0.08]]), np.array([0.01,0.01]));"
-        "s.step(1); t2=time.perf_counter(); s.step(1); t3=time.perf_counter();"
-        "print(t1-t0, t2-t1, t3-t2)"
-    )
-    out = {}
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
-        for label in ("cold_cache", "warm_cache"):
-            res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-            if res.returncode != 0:
-                raise RuntimeError(res.stderr)
-            t_import, t_first, t_second = (float(v) for v in res.stdout.split()[-3:])
-            out[label] = {"init_s": t_import, "first_step_s": t_first, "steady_step_s": t_second}
-    return out
 
 
 def run_wheelsoil(bed, steps: int, warmup: int) -> dict:
@@ -233,8 +207,7 @@ def main(argv=None) -> int:
     from wheelsoil.provenance import provenance
 
     runtime.init()
-    report: dict = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
-                                "processor": platform.processor()}}
+    report: dict = {"machine": machine(), "versions": versions()}
     t0 = time.perf_counter()
     bed = prepare_bed(bench_spec(args), progress=True)
     report["bed"] = {"particles": bed.n_particles, "from_cache": bed.meta.get("from_cache"),

@@ -2,7 +2,8 @@
 
 Exit codes (scripts can trust them):
     0  success
-    1  unexpected internal error (a bug: please report it with the traceback)
+    1  unexpected internal error (a bug: please report it with the traceback), or a benchmark
+       regression beyond the tolerance (``bench --smoke --baseline``)
     2  bad input (a parameter out of range, a missing file); the message names the value
     3  the simulation went unstable or did not settle; nothing was written
 """
@@ -99,6 +100,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="iso", help="camera preset: iso, side, top, front (default iso)")
     p.add_argument("--size", type=int, nargs=2, default=(1200, 800), metavar=("W", "H"), help="image size in pixels")
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("bench", help="measure solver speed (smoke tier for CI, or the full tier)",
+                       description="Benchmarks (benchmarks/README.md). --smoke: a few minutes on 2 cores -- DEM "
+                                   "steady stepping on a small dense bed, compile time, peak memory -- each figure "
+                                   "also normalised by a NumPy reference workload; with --baseline, a regression "
+                                   "beyond --tolerance fails (exit 1) naming the figure. Without --smoke: the full "
+                                   "tier (>= 50k-particle bed, LIGGGHTS comparison, seed-004 memory check).")
+    p.add_argument("--smoke", action="store_true", help="run the smoke tier")
+    p.add_argument("--out", type=Path, default=None, help="JSON to write (default benchmarks/results/<tier>.json)")
+    p.add_argument("--baseline", type=Path, default=None, help="smoke: baseline JSON to gate regressions against")
+    p.add_argument("--tolerance", type=float, default=0.5, help="smoke: allowed normalised regression (default 0.5)")
+    p.add_argument("--record", action="store_true", help="smoke: append the result to benchmarks/history/smoke.jsonl")
+    p.add_argument("--no-liggghts", action="store_true", help="full tier: skip the LIGGGHTS comparison")
+    p.add_argument("--memory-check", action="store_true", help="full tier: also step a seed-004-size bed")
+    p.set_defaults(func=cmd_bench)
     return parser
 
 
@@ -149,6 +165,25 @@ def cmd_render(args) -> int:
     console = _console()
     console.print(f"wrote {render_bed(bed, out, camera=args.camera, size=tuple(args.size))}")
     return EXIT_OK
+
+
+def cmd_bench(args) -> int:
+    if args.smoke:
+        from wheelsoil.benchmarks import smoke
+
+        argv = ["--tolerance", str(args.tolerance)]
+        if args.out:
+            argv += ["--out", str(args.out)]
+        if args.baseline:
+            argv += ["--baseline", str(args.baseline)]
+        if args.record:
+            argv.append("--record")
+        return smoke.main(argv)
+    from wheelsoil.benchmarks import dem_throughput
+
+    argv = (["--out", str(args.out)] if args.out else []) + (["--no-liggghts"] if args.no_liggghts else [])
+    argv += ["--memory-check"] if args.memory_check else []
+    return dem_throughput.main(argv)
 
 
 class _InputError(ValueError):

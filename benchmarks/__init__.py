@@ -1,0 +1,1 @@
+"""Throughput and scaling benchmarks (see benchmarks/README.md); installed as ``wheelsoil.benchmarks``."""

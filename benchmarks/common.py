@@ -1,0 +1,81 @@
+"""Measurement helpers shared by the benchmark tiers: machine description, peak memory, reference
+workload, cold/warm kernel compile time."""
+
+from __future__ import annotations
+
+import os
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+
+def peak_rss_mib() -> float:
+    """Peak resident set size of this process [MiB] (Linux reports ru_maxrss in KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def machine() -> dict:
+    """What the figures were measured on."""
+    cpu = platform.processor() or ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return {"platform": platform.platform(), "cpu": cpu, "cores": os.cpu_count(), "python": sys.version.split()[0]}
+
+
+def versions() -> dict:
+    import taichi as ti
+
+    from wheelsoil import __version__
+
+    return {"wheelsoil": __version__, "taichi": ".".join(map(str, ti.__version__)), "numpy": np.__version__}
+
+
+def reference_workload_seconds(repeats: int = 5) -> float:
+    """Best-of-``repeats`` time [s] of a fixed NumPy workload (element-wise f64 arithmetic with a
+    square root and a division over 1e6 values, then a sort), the yardstick that every benchmark
+    figure is divided by so that figures from machines of different speed can be compared."""
+    rng = np.random.default_rng(12345)
+    a, b, c = rng.random((3, 1_000_000))
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(10):
+            x = np.sqrt(a * a + b * b) / (1.0 + c)
+            x.sort()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def compile_time_cold() -> dict:
+    """Time to the end of the first step of a small scene in a fresh process, with an empty Taichi
+    kernel cache (``cold_cache``) and then with the cache it filled (``warm_cache``) [s]."""
+    code = (
+        "import time; t0=time.perf_counter();"
+        "import numpy as np; from wheelsoil.granular import Scene, runtime;"
+        "runtime.init(); t1=time.perf_counter();"
+        "s=Scene((0,0,0),(0.2,0.2,0.2)); s.add_box_walls();"
+        "s.add_spheres(np.array([[0.1,0.1,0.05],[0.1,0.1,0.08]]), np.array([0.01,0.01]));"
+        "s.step(1); t2=time.perf_counter(); s.step(1); t3=time.perf_counter();"
+        "print(t1-t0, t2-t1, t3-t2)"
+    )
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
+        for label in ("cold_cache", "warm_cache"):
+            res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+            if res.returncode != 0:
+                raise RuntimeError(res.stderr)
+            t_init, t_first, t_second = (float(v) for v in res.stdout.split()[-3:])
+            out[label] = {"init_s": t_init, "first_step_s": t_first, "steady_step_s": t_second}
+    return out
