@@ -12,6 +12,23 @@ import taichi as ti
 from .neighbors import nd_f64, nd_vec3, vec3
 
 
+@ti.func
+def half_kick(
+    i,
+    v: ti.template(),
+    omega: ti.template(),
+    force: ti.template(),
+    torque: ti.template(),
+    mass: ti.template(),
+    inertia: ti.template(),
+    gravity,
+    half,
+):
+    """v += dt/2 (F/m + g), omega += dt/2 T/I for particle i."""
+    v[i] += half * (force[i] / mass[i] + gravity)
+    omega[i] += half * (torque[i] / inertia[i])
+
+
 @ti.kernel
 def kick_drift(
     x: nd_vec3,
@@ -30,8 +47,7 @@ def kick_drift(
     half = 0.5 * dt
     largest = 0.0
     for i in x:
-        v[i] += half * (force[i] / mass[i] + gravity)
-        omega[i] += half * (torque[i] / inertia[i])
+        half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
         x[i] += dt * v[i]
         ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr())
     return largest
@@ -51,8 +67,7 @@ def kick(
     """Second half kick of v and omega with the forces at the new positions."""
     half = 0.5 * dt
     for i in v:
-        v[i] += half * (force[i] / mass[i] + gravity)
-        omega[i] += half * (torque[i] / inertia[i])
+        half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
 
 
 @ti.kernel

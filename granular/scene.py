@@ -293,7 +293,7 @@ class Scene:
         """Rayleigh and Hertz estimates for the smallest sphere (see :mod:`.timestep`)."""
         if self.n_particles == 0:
             raise WheelsoilInputError("the scene has no spheres; add some before asking for a time step")
-        r_min = float(self._r.min()) if self._dev is None else float(self._dev["r_min"])
+        r_min = float(self._r.min())
         wall_moduli = tuple(effective_modulus(self.material, w.material) for w in self.walls)
         return estimate_time_step(
             r_min,
@@ -416,7 +416,7 @@ class Scene:
         h = self._hist
         if h is not None:
             width = max(width, h["nbr"].shape[1])
-        mass = self.material.density * 4.0 / 3.0 * np.pi * self._r**3
+        mass = self.masses
         d: dict = {
             "n": n,
             "r_min": r_min,
