@@ -30,9 +30,8 @@ Equations (seed 004, section 2.2; same form as EDEM "Hertz-Mindlin (no slip)", L
 
 Sign conventions: ``n`` is the unit vector from body *i* towards its partner at the contact,
 ``v_rel`` is the velocity of *i*'s surface point relative to the partner's surface point, so the
-normal approach speed is v_n = v_rel . n (> 0 while closing). The function is written so that the
-partner's evaluation (n -> -n, v_rel -> -v_rel, xi -> -xi) returns exactly the negated force, which
-makes action equal reaction to the last bit when both sides of a pair are evaluated.
+normal approach speed is v_n = v_rel . n (> 0 while closing). Each contact is evaluated once; the
+partner receives the negated force and rolling torque (see :mod:`.forces`).
 """
 
 

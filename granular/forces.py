@@ -1,17 +1,25 @@
-"""Contact-force kernel: gathers, for every particle, the Hertz--Mindlin forces of its partners and walls.
+"""Contact-force kernels: each pair evaluated once, forces gathered per particle without atomics.
 
-Each particle sums the forces that act on it (a gather: no floating-point atomics, no scatter), so
-every pair is evaluated from both sides; the two evaluations are mirror images (see
-:mod:`.contact`), so action equals reaction to round-off. A two-pass variant that evaluates each
-pair once, stores the result per slot and gathers it through a mirror index was measured slower on
-CPU (benchmarks/README.md): the extra slot traffic costs more than the halved arithmetic.
+Two passes per step (Newton's third law without floating-point atomics):
+
+1. parallel over the compact pair list (owner i < j): evaluate the Hertz--Mindlin law once per
+   pair and store the force on i, the tangential moment n x F_t and the rolling torque on i in the
+   pair's slot;
+2. parallel over particles: sum the slots of each particle's pairs through its gather index (with
+   the opposite sign for pairs its partner owns), in sorted row order, then add its wall contacts.
+
+Both loops live in one kernel (:func:`contact_forces`): one launch per step.
+
+The force on j is the exact negative of the force on i, so action equals reaction to the bit, and
+the fixed summation order makes results deterministic. The compact slot array (72 bytes per pair)
+stays in the last-level cache between the passes; an earlier layout with per-row padded slots did
+not, and evaluating every pair from both sides was faster than it (benchmarks/README.md).
 """
-
 
 import taichi as ti
 
 from .contact import hertz_mindlin
-from .neighbors import nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
+from .neighbors import mat3, nd_f64, nd_i32, nd_mat3, nd_vec3, nd_vec3_2d, vec3
 
 nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -27,13 +35,19 @@ def contact_forces(
     radius: nd_f64,
     mass: nd_f64,
     inertia: nd_f64,
-    nbr: nd_i32_2d,
-    nbr_count: nd_i32,
-    xi: nd_vec3_2d,
+    pair_i: nd_i32,
+    pair_j: nd_i32,
+    pair_xi: nd_vec3,
+    n_pairs: ti.i32,
+    slot: nd_mat3,
+    touching_flag: nd_i32,
+    gather_start: nd_i32,
+    gather: nd_i32,
     wall_point: nd_vec3,
     wall_normal: nd_vec3,
     wall_props: nd_f64_2d,
     xi_wall: nd_vec3_2d,
+    wall_touching: nd_i32,
     e_eff: ti.f64,
     g_eff: ti.f64,
     beta: ti.f64,
@@ -43,69 +57,89 @@ def contact_forces(
     force: nd_vec3,
     torque: nd_vec3,
 ) -> ti.i32:
-    """Write the contact force [N] and torque [N m] on every particle; return the number of contacts.
+    """Contact force [N] and torque [N m] on every particle; returns the number of contacts
+    (touching pairs plus particle--wall contacts). Two parallel loops, run one after the other:
 
-    Pairs are counted once (i < j); particle--wall contacts once each.
+    1. over the pair list: evaluate each pair once; slot rows: force on i [N], n x F_t [N], rolling
+       torque on i [N m]; ``touching_flag[p]`` says whether the slot holds this step's force
+       (separated pairs only clear their flag and, once, their history: no zero slots are written);
+    2. over particles: sum the slots of the particle's pairs through its gather index (negated for
+       pairs its partner owns: the tangential force acts at distance r from each centre, so both
+       bodies receive r (n x F_t); the rolling torque is +M on the owner and -M on the partner),
+       then add wall contacts. ``wall_touching[i]`` is a bit mask of the walls particle i touched
+       at the last step, so a wall history is cleared once on separation rather than every step.
     """
     n_contacts = 0
-    for i in x:
-        xi_pos = x[i]
+    for p in range(n_pairs):
+        i = pair_i[p]
+        j = pair_j[p]
+        d = x[j] - x[i]
         ri = radius[i]
-        mi = mass[i]
-        ii = inertia[i]
-        vi = v[i]
-        wi = omega[i]
+        rj = radius[j]
+        reach = ri + rj
+        dist2 = d.norm_sqr()
+        if dist2 < reach * reach:
+            dist = ti.sqrt(dist2)
+            n = d / dist
+            mi = mass[i]
+            mj = mass[j]
+            ii = inertia[i]
+            ij = inertia[j]
+            surf_i = v[i] + omega[i].cross(ri * n)
+            surf_j = v[j] + omega[j].cross(-rj * n)
+            fc, tn, m_roll, xi_new = hertz_mindlin(
+                n,
+                reach - dist,
+                surf_i - surf_j,
+                omega[i] - omega[j],
+                ri * rj / reach,
+                mi * mj / (mi + mj),
+                ii * ij / (ii + ij),
+                e_eff,
+                g_eff,
+                beta,
+                mu_s,
+                mu_r,
+                pair_xi[p],
+                dt,
+            )
+            pair_xi[p] = xi_new
+            slot[p] = mat3([[fc[0], fc[1], fc[2]], [tn[0], tn[1], tn[2]], [m_roll[0], m_roll[1], m_roll[2]]])
+            touching_flag[p] = 1
+            n_contacts += 1
+        elif touching_flag[p] != 0:
+            touching_flag[p] = 0
+            pair_xi[p] = vec3(0.0, 0.0, 0.0)
+    for i in x:
+        ri = radius[i]
         f = vec3(0.0, 0.0, 0.0)
-        t = vec3(0.0, 0.0, 0.0)
-        for k in range(nbr_count[i]):
-            j = nbr[i, k]
-            d = x[j] - xi_pos
-            rj = radius[j]
-            reach = ri + rj
-            dist2 = d.norm_sqr()
-            if dist2 < reach * reach:
-                dist = ti.sqrt(dist2)
-                n = d / dist
-                mj = mass[j]
-                ij = inertia[j]
-                surf_i = vi + wi.cross(ri * n)
-                surf_j = v[j] + omega[j].cross(-rj * n)
-                fc, tn, m_roll, xi_new = hertz_mindlin(
-                    n,
-                    reach - dist,
-                    surf_i - surf_j,
-                    wi - omega[j],
-                    ri * rj / reach,
-                    mi * mj / (mi + mj),
-                    ii * ij / (ii + ij),
-                    e_eff,
-                    g_eff,
-                    beta,
-                    mu_s,
-                    mu_r,
-                    xi[i, k],
-                    dt,
-                )
-                xi[i, k] = xi_new
-                f += fc
-                t += ri * tn + m_roll
-                if i < j:
-                    n_contacts += 1
-            else:
-                xi[i, k] = vec3(0.0, 0.0, 0.0)
+        tn = vec3(0.0, 0.0, 0.0)
+        roll = vec3(0.0, 0.0, 0.0)
+        for e in range(gather_start[i], gather_start[i + 1]):
+            q = gather[e]
+            if touching_flag[q >> 1] != 0:
+                s = slot[q >> 1]
+                sign = 1.0 - 2.0 * ti.cast(q & 1, ti.f64)
+                f += sign * vec3(s[0, 0], s[0, 1], s[0, 2])
+                tn += vec3(s[1, 0], s[1, 1], s[1, 2])
+                roll += sign * vec3(s[2, 0], s[2, 1], s[2, 2])
+        t = ri * tn + roll
+        xi_pos = x[i]
+        mask = wall_touching[i]
+        new_mask = 0
         for w in range(wall_point.shape[0]):
             nw = wall_normal[w]
             gap = (xi_pos - wall_point[w]).dot(nw)
             if gap < ri:
                 n = -nw
-                fc, tn, m_roll, xi_new = hertz_mindlin(
+                fc, tw, m_roll, xi_new = hertz_mindlin(
                     n,
                     ri - gap,
-                    vi + wi.cross(ri * n),
-                    wi,
+                    v[i] + omega[i].cross(ri * n),
+                    omega[i],
                     ri,
-                    mi,
-                    ii,
+                    mass[i],
+                    inertia[i],
                     wall_props[w, WALL_E_EFF],
                     wall_props[w, WALL_G_EFF],
                     wall_props[w, WALL_BETA],
@@ -116,10 +150,13 @@ def contact_forces(
                 )
                 xi_wall[i, w] = xi_new
                 f += fc
-                t += ri * tn + m_roll
+                t += ri * tw + m_roll
                 n_contacts += 1
-            else:
+                new_mask |= 1 << w
+            elif (mask >> w) & 1:
                 xi_wall[i, w] = vec3(0.0, 0.0, 0.0)
+        if new_mask != mask:
+            wall_touching[i] = new_mask
         force[i] = f
         torque[i] = t
     return n_contacts

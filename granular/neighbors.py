@@ -4,8 +4,10 @@ Particles are binned into cubic cells of edge ``cell_size`` >= 2 r_max + skin by
 (integer atomics only), then every particle gathers the partners within r_i + r_j + skin from the
 27 surrounding cells into its own row of a fixed-width list. Rows are sorted by partner index, which
 makes the force summation order -- and hence the result -- independent of the cell size and of the
-thread schedule. The tangential history of a contact moves with its partner index from the old list
-to the new one (a merge of two sorted rows), so contacts survive any number of rebuilds.
+thread schedule. From the rows, every pair is listed once (owner i < j) in a compact pair list that
+holds the pair's tangential history; at a rebuild the history moves from the old pair list to the
+new one (a merge of two sorted lists), so contacts survive any number of rebuilds. A gather index
+tells each particle which pairs it takes part in, in row order.
 """
 
 
@@ -19,6 +21,8 @@ nd_vec3_2d = ti.types.ndarray(dtype=vec3, ndim=2)
 nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd_i32_2d = ti.types.ndarray(dtype=ti.i32, ndim=2)
+mat3 = ti.types.matrix(3, 3, ti.f64)
+nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
 
 
 @ti.func
@@ -42,14 +46,15 @@ def bin_particles(
 
 
 @ti.kernel
-def exclusive_scan(cell_count: nd_i32, cell_start: nd_i32):
-    """cell_start[c] = sum of counts of cells before c; cell_start[n_cells] = total."""
+def exclusive_scan(cell_count: nd_i32, cell_start: nd_i32) -> ti.i32:
+    """cell_start[c] = sum of counts before c; cell_start[n] = total, which is also returned."""
     for _ in range(1):  # one serial task
         acc = 0
         for c in range(cell_count.shape[0]):
             cell_start[c] = acc
             acc += cell_count[c]
         cell_start[cell_count.shape[0]] = acc
+    return cell_start[cell_count.shape[0]]
 
 
 @ti.kernel
@@ -112,24 +117,85 @@ def build_neighbor_lists(
     return most
 
 
+# ---------------------------------------------------------------------------------------------
+# Pair list: every listed pair once (owner i < j), stored compactly, with its tangential history,
+# and for every particle the pairs it takes part in (the gather index).
+
+
 @ti.kernel
-def carry_history(
-    old_nbr: nd_i32_2d,
-    old_count: nd_i32,
-    old_xi: nd_vec3_2d,
-    new_nbr: nd_i32_2d,
-    new_count: nd_i32,
-    new_xi: nd_vec3_2d,
+def count_owned(nbr: nd_i32_2d, nbr_count: nd_i32, owned: nd_i32):
+    """owned[i] = number of row entries j > i (rows are sorted, so they are the row's tail)."""
+    for i in nbr_count:
+        c = 0
+        for k in range(nbr_count[i]):
+            if nbr[i, k] > i:
+                c += 1
+        owned[i] = c
+
+
+@ti.kernel
+def fill_pairs(
+    nbr: nd_i32_2d,
+    nbr_count: nd_i32,
+    pair_start: nd_i32,
+    pair_i: nd_i32,
+    pair_j: nd_i32,
+    pair_xi: nd_vec3,
+    pair_touching: nd_i32,
+    old_start: nd_i32,
+    old_j: nd_i32,
+    old_xi: nd_vec3,
+    old_touching: nd_i32,
+    n_old_particles: ti.i32,
 ):
-    """Copy each contact's tangential history to its slot in the new (sorted) rows; new pairs start at 0."""
-    for i in new_count:
+    """Write the owned pairs of every particle from its sorted row, carrying each pair's history
+    and touching flag from the previous pair list (a merge of two sorted lists); new pairs start
+    at zero, untouched."""
+    for i in nbr_count:
+        p = pair_start[i]
         a = 0
-        n_old = old_count[i]
-        for k in range(new_count[i]):
-            j = new_nbr[i, k]
-            while a < n_old and old_nbr[i, a] < j:
-                a += 1
-            if a < n_old and old_nbr[i, a] == j:
-                new_xi[i, k] = old_xi[i, a]
+        b = 0
+        if i < n_old_particles:
+            a = old_start[i]
+            b = old_start[i + 1]
+        for k in range(nbr_count[i]):
+            j = nbr[i, k]
+            if j > i:
+                pair_i[p] = i
+                pair_j[p] = j
+                while a < b and old_j[a] < j:
+                    a += 1
+                if a < b and old_j[a] == j:
+                    pair_xi[p] = old_xi[a]
+                    pair_touching[p] = old_touching[a]
+                else:
+                    pair_xi[p] = vec3(0.0, 0.0, 0.0)
+                    pair_touching[p] = 0
+                p += 1
+
+
+@ti.kernel
+def fill_gather_index(
+    nbr: nd_i32_2d, nbr_count: nd_i32, pair_start: nd_i32, pair_j: nd_i32, gather_start: nd_i32, gather: nd_i32
+):
+    """gather[e] = 2 p for a pair p that particle i owns, 2 p + 1 for one owned by its partner j < i
+    (found by binary search in j's sorted pairs); entries follow the sorted row order."""
+    for i in nbr_count:
+        e = gather_start[i]
+        p_own = pair_start[i]
+        for k in range(nbr_count[i]):
+            j = nbr[i, k]
+            if j > i:
+                gather[e] = 2 * p_own
+                p_own += 1
             else:
-                new_xi[i, k] = vec3(0.0, 0.0, 0.0)
+                lo = pair_start[j]
+                hi = pair_start[j + 1] - 1
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if pair_j[mid] < i:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                gather[e] = 2 * lo + 1
+            e += 1

@@ -155,7 +155,7 @@ class Scene:
         self._r = np.zeros(0)
         self._f = np.zeros((0, 3))
         self._t = np.zeros((0, 3))
-        self._hist: dict | None = None  # neighbour rows and tangential history on the host
+        self._hist: dict | None = None  # pair list with tangential history, wall history (host copy)
         self._dev: dict | None = None
 
     # ------------------------------------------------------------------ building the scene
@@ -241,11 +241,8 @@ class Scene:
         self._r = np.concatenate([self._r, r])
         self._f = np.concatenate([self._f, np.zeros((n, 3))])
         self._t = np.concatenate([self._t, np.zeros((n, 3))])
-        if self._hist is not None:
+        if self._hist is not None:  # new spheres have no pairs yet; existing indices are unchanged
             h = self._hist
-            h["nbr"] = np.concatenate([h["nbr"], np.zeros((n, h["nbr"].shape[1]), np.int32)])
-            h["count"] = np.concatenate([h["count"], np.zeros(n, np.int32)])
-            h["xi"] = np.concatenate([h["xi"], np.zeros((n,) + h["xi"].shape[1:])])
             h["xi_wall"] = np.concatenate([h["xi_wall"], np.zeros((n,) + h["xi_wall"].shape[1:])])
         return slice(start, start + n)
 
@@ -261,17 +258,10 @@ class Scene:
             h = self._hist
             new_index = np.full(mask.size, -1, np.int64)
             new_index[mask] = np.arange(int(mask.sum()))
-            nbr, count, xi = h["nbr"][mask], h["count"][mask], h["xi"][mask]
-            width = nbr.shape[1]
-            valid = np.arange(width)[None, :] < count[:, None]
-            mapped = np.where(valid, new_index[nbr], -1)
-            keep = mapped >= 0
-            order = np.argsort(~keep, axis=1, kind="stable")  # kept entries first, order preserved
-            mapped = np.take_along_axis(mapped, order, axis=1)
-            xi = np.take_along_axis(xi, order[:, :, None], axis=1)
-            h["count"] = keep.sum(axis=1).astype(np.int32)
-            h["nbr"] = np.where(mapped >= 0, mapped, 0).astype(np.int32)
-            h["xi"] = np.where((mapped >= 0)[:, :, None], xi, 0.0)
+            pi, pj = new_index[h["pair_i"]], new_index[h["pair_j"]]
+            kept = (pi >= 0) & (pj >= 0)  # the renumbering is monotone: pairs stay sorted
+            h["pair_i"], h["pair_j"] = pi[kept].astype(np.int32), pj[kept].astype(np.int32)
+            h["pair_xi"] = h["pair_xi"][kept]
             h["xi_wall"] = h["xi_wall"][mask]
 
     def set_velocities(self, velocities=None, angular_velocities=None) -> None:
@@ -354,12 +344,14 @@ class Scene:
 
     def _compute_forces(self, dt: float) -> int:
         d = self._dev
+        pairs = d["pairs"]
         return forces.contact_forces(
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
-            d["nbr"], d["count"], d["xi"],
-            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"],
-            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction,
-            dt, d["f"], d["t"],
+            pairs["i"], pairs["j"], pairs["xi"], d["n_pairs"], pairs["slot"], pairs["touching"],
+            d["gather_start"], d["gather"],
+            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
+            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
+            d["f"], d["t"],
         )
 
     def check_health(self) -> dict:
@@ -414,8 +406,6 @@ class Scene:
             raise WheelsoilInputError(f"neighbour grid of {dims.tolist()} cells is too large; raise cell_size")
         width = neighbor_row_width(r_min, r_max, skin)
         h = self._hist
-        if h is not None:
-            width = max(width, h["nbr"].shape[1])
         mass = self.masses
         d: dict = {
             "n": n,
@@ -452,14 +442,22 @@ class Scene:
         d["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
         d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
         self._alloc_rows(d, width)
-        if h is not None:
-            nb = np.zeros((n, width), np.int32)
-            nb[:, : h["nbr"].shape[1]] = h["nbr"]
-            xi = np.zeros((n, width, 3))
-            xi[:, : h["xi"].shape[1]] = h["xi"]
-            d["nbr"].from_numpy(nb)
-            d["count"].from_numpy(h["count"])
-            d["xi"].from_numpy(xi)
+        d["owned"] = ti.ndarray(ti.i32, shape=n)
+        d["pair_start"] = ti.ndarray(ti.i32, shape=n + 1)
+        d["gather_start"] = ti.ndarray(ti.i32, shape=n + 1)
+        # the pair list the first build carries the history from (the host copy, if any)
+        pairs = self._pair_buffers(max(1, len(h["pair_i"])) if h is not None else 1)
+        pairs["n_particles"] = 0
+        if h is not None and len(h["pair_i"]):
+            start = np.zeros(n + 1, np.int32)
+            start[1:] = np.cumsum(np.bincount(h["pair_i"], minlength=n))
+            pairs["start"].from_numpy(start)
+            pairs["j"].from_numpy(np.ascontiguousarray(h["pair_j"], dtype=np.int32))
+            pairs["xi"].from_numpy(np.ascontiguousarray(h["pair_xi"], dtype=np.float64))
+            pairs["touching"].from_numpy(np.any(h["pair_xi"] != 0.0, axis=1).astype(np.int32))
+            pairs["n_particles"] = n
+        d["pairs"], d["n_pairs"] = pairs, 0
+        d["gather"] = ti.ndarray(ti.i32, shape=1)
         n_walls = len(self.walls)
         d["wall_point"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
         d["wall_normal"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
@@ -474,9 +472,16 @@ class Scene:
             props[k, forces.WALL_MU_S] = w.pair.static_friction
             props[k, forces.WALL_MU_R] = w.pair.rolling_friction
         d["wall_props"] = scal(props)
+        if n_walls > 31:
+            raise WheelsoilInputError(f"{n_walls} walls: at most 31 planar walls are supported")
         d["xi_wall"] = ti.Vector.ndarray(3, ti.f64, shape=(n, max(n_walls, 1)))
+        d["xi_wall"].fill(0.0)
+        d["wall_touching"] = ti.ndarray(ti.i32, shape=n)
+        d["wall_touching"].fill(0)
         if h is not None and n_walls:
             d["xi_wall"].from_numpy(np.ascontiguousarray(h["xi_wall"]))
+            touching = np.any(h["xi_wall"] != 0.0, axis=2)  # (n, walls)
+            d["wall_touching"].from_numpy((touching * (1 << np.arange(n_walls))).sum(axis=1).astype(np.int32))
         d["health"] = ti.ndarray(ti.f64, shape=4)
         self._dev = d
         self._rebuild_neighbors()
@@ -484,13 +489,23 @@ class Scene:
 
     @staticmethod
     def _alloc_rows(d: dict, width: int) -> None:
-        n = d["n"]
+        """Neighbour rows (scratch for building the pair list; they carry no history)."""
         d["width"] = width
-        for suffix in ("", "_new"):
-            d["nbr" + suffix] = ti.ndarray(ti.i32, shape=(n, width))
-            d["count" + suffix] = ti.ndarray(ti.i32, shape=n)
-            d["xi" + suffix] = ti.Vector.ndarray(3, ti.f64, shape=(n, width))
-        d["count"].fill(0)
+        d["nbr"] = ti.ndarray(ti.i32, shape=(d["n"], width))
+        d["count"] = ti.ndarray(ti.i32, shape=d["n"])
+
+    def _pair_buffers(self, capacity: int) -> dict:
+        """Arrays of a pair list with room for ``capacity`` pairs."""
+        n = self.n_particles
+        return {
+            "capacity": capacity,
+            "start": ti.ndarray(ti.i32, shape=n + 1),
+            "i": ti.ndarray(ti.i32, shape=capacity),
+            "j": ti.ndarray(ti.i32, shape=capacity),
+            "xi": ti.Vector.ndarray(3, ti.f64, shape=capacity),
+            "slot": ti.ndarray(neighbors.mat3, shape=capacity),
+            "touching": ti.ndarray(ti.i32, shape=capacity),
+        }
 
     def _rebuild_neighbors(self) -> None:
         d = self._dev
@@ -499,39 +514,42 @@ class Scene:
         neighbors.bin_particles(d["x"], origin, inv_cell, d["dims"], d["cell_of"], d["cell_count"])
         neighbors.exclusive_scan(d["cell_count"], d["cell_start"])
         neighbors.scatter_to_cells(d["cell_of"], d["cell_start"], d["cell_count"], d["sorted_ids"])
-        most = neighbors.build_neighbor_lists(
-            d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
-            d["nbr_new"], d["count_new"],
-        )
+
+        def build_rows() -> int:
+            return neighbors.build_neighbor_lists(
+                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
+                d["nbr"], d["count"],
+            )
+
+        most = build_rows()
         fitted = most + max(4, most // 4)
         if most > d["width"] or 2 * fitted < d["width"]:
             # Rows too narrow, or far wider than needed (wide rows waste cache): refit them.
-            self._refit_rows(fitted)
-            neighbors.build_neighbor_lists(
-                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
-                d["nbr_new"], d["count_new"],
-            )
-        neighbors.carry_history(d["nbr"], d["count"], d["xi"], d["nbr_new"], d["count_new"], d["xi_new"])
-        for key in ("nbr", "count", "xi"):
-            d[key], d[key + "_new"] = d[key + "_new"], d[key]
+            if fitted > 4096:
+                raise CapacityError(f"a particle has {most} neighbours; the size ratio or skin is unreasonable")
+            self._alloc_rows(d, fitted)
+            build_rows()
+
+        # The new pair list (owned pairs i < j, compact), with history carried from the current one.
+        old = d["pairs"]
+        new = d.pop("spare", None) or self._pair_buffers(1)
+        neighbors.count_owned(d["nbr"], d["count"], d["owned"])
+        n_pairs = neighbors.exclusive_scan(d["owned"], new["start"])
+        if n_pairs > new["capacity"]:
+            new = self._pair_buffers(int(n_pairs * 1.25) + 16)
+            neighbors.exclusive_scan(d["owned"], new["start"])
+        neighbors.fill_pairs(
+            d["nbr"], d["count"], new["start"], new["i"], new["j"], new["xi"], new["touching"],
+            old["start"], old["j"], old["xi"], old["touching"], old["n_particles"],
+        )
+        new["n_particles"] = d["n"]
+        n_entries = neighbors.exclusive_scan(d["count"], d["gather_start"])
+        if n_entries > d["gather"].shape[0]:
+            d["gather"] = ti.ndarray(ti.i32, shape=int(n_entries * 1.25) + 16)
+        neighbors.fill_gather_index(d["nbr"], d["count"], new["start"], new["j"], d["gather_start"], d["gather"])
+        d["pairs"], d["spare"], d["n_pairs"] = new, old, n_pairs
         integrator.copy_vec3(d["x"], d["x_ref"])
         self.neighbor_rebuilds += 1
-
-    def _refit_rows(self, width: int) -> None:
-        d = self._dev
-        if width > 4096:
-            raise CapacityError(f"a particle has {width} neighbours; the size ratio or skin is unreasonable")
-        old = {k: d[k].to_numpy() for k in ("nbr", "count", "xi")}
-        width = max(width, int(old["count"].max(initial=0)))  # the old rows' history must fit too
-        keep = min(width, old["nbr"].shape[1])
-        self._alloc_rows(d, width)
-        nb = np.zeros((d["n"], width), np.int32)
-        nb[:, :keep] = old["nbr"][:, :keep]
-        xi = np.zeros((d["n"], width, 3))
-        xi[:, :keep] = old["xi"][:, :keep]
-        d["nbr"].from_numpy(nb)
-        d["count"].from_numpy(old["count"])
-        d["xi"].from_numpy(xi)
 
     def _to_host(self) -> None:
         """Copy the device state back to NumPy and drop the device arrays (before structural edits)."""
@@ -540,10 +558,11 @@ class Scene:
             return
         self._x, self._v, self._w = d["x"].to_numpy(), d["v"].to_numpy(), d["w"].to_numpy()
         self._f, self._t = d["f"].to_numpy(), d["t"].to_numpy()
+        pairs, n_pairs = d["pairs"], d["n_pairs"]
         self._hist = {
-            "nbr": d["nbr"].to_numpy(),
-            "count": d["count"].to_numpy(),
-            "xi": d["xi"].to_numpy(),
+            "pair_i": pairs["i"].to_numpy()[:n_pairs],
+            "pair_j": pairs["j"].to_numpy()[:n_pairs],
+            "pair_xi": pairs["xi"].to_numpy()[:n_pairs],
             "xi_wall": d["xi_wall"].to_numpy()[:, : len(self.walls)],
         }
         self._dev = None
