@@ -172,3 +172,32 @@ def test_numpy_round_trip_of_state():
     s.step(5)
     assert s.positions.dtype == np.float64 and s.velocities.shape == (2, 3)
     assert s.masses == pytest.approx(3200 * 4 / 3 * np.pi * np.array([0.01, 0.012]) ** 3)
+
+
+def test_structural_edits_keep_pair_history_and_dynamics():
+    """Adding and removing spheres that touch nothing -- which round-trips the state through the host
+    and renumbers every pair -- must leave the pile's dynamics unchanged: only possible if every
+    pair's tangential history survives the edit."""
+    x, r, v = random_packing()
+    far = np.array([[0.14, 0.14, 0.29]])
+
+    def pile(with_far):
+        s = Scene((0, 0, 0), (0.15, 0.15, 0.3))
+        s.add_box_walls()
+        s.add_spheres(np.vstack([far, x]), np.concatenate([[0.006], r]), velocities=np.vstack([[0, 0, 0], v]))
+        s.time_step = 5e-5
+        return s
+
+    edited, reference = pile(True), pile(True)
+    edited.step(2500)
+    n_pairs_before = edited._dev["n_pairs"]
+    edited.add_spheres([[0.01, 0.14, 0.29]], [0.006])  # another far sphere
+    edited.step(1)
+    keep = np.ones(edited.n_particles, bool)
+    keep[0] = False  # drop the first far sphere: every other index shifts down by one
+    edited.keep_spheres(keep)
+    edited.step(499)
+    reference.step(3000)
+    assert n_pairs_before > 100 and reference.contact_count > 100
+    np.testing.assert_allclose(edited.positions[: len(r)], reference.positions[1:], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(edited.angular_velocities[: len(r)], reference.angular_velocities[1:], rtol=0, atol=1e-9)
