@@ -38,6 +38,10 @@ from .materials import (
 from .timestep import TimeStepEstimate, estimate_time_step
 
 
+#: Most planar walls per scene: each particle keeps a 32-bit mask of the walls it touches.
+MAX_WALLS = 31
+
+
 @dataclass(frozen=True)
 class Wall:
     """An infinite rigid plane. ``normal`` points into the side where particles live.
@@ -176,6 +180,10 @@ class Scene:
         length = float(np.linalg.norm(nrm))
         if length == 0.0:
             raise WheelsoilInputError("wall normal (0, 0, 0) has no direction")
+        if len(self.walls) >= MAX_WALLS:
+            raise WheelsoilInputError(
+                f"a scene holds at most {MAX_WALLS} planar walls (each particle tracks its wall contacts in a bit mask)"
+            )
         if material is not None and not isinstance(material, Material):
             raise WheelsoilInputError(f"wall material must be a Material or None, got {type(material).__name__}")
         if not isinstance(pair, PairProperties):
@@ -413,7 +421,6 @@ class Scene:
             "skin": skin,
             "cell": cell,
             "dims": [int(v) for v in dims],
-            "width": width,
             "e_eff": effective_modulus(self.material, self.material),
             "g_eff": effective_shear_modulus(self.material, self.material),
             "beta": self.pair.damping_ratio,
@@ -443,7 +450,6 @@ class Scene:
         d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
         self._alloc_rows(d, width)
         d["owned"] = ti.ndarray(ti.i32, shape=n)
-        d["pair_start"] = ti.ndarray(ti.i32, shape=n + 1)
         d["gather_start"] = ti.ndarray(ti.i32, shape=n + 1)
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = self._pair_buffers(max(1, len(h["pair_i"])) if h is not None else 1)
@@ -472,8 +478,6 @@ class Scene:
             props[k, forces.WALL_MU_S] = w.pair.static_friction
             props[k, forces.WALL_MU_R] = w.pair.rolling_friction
         d["wall_props"] = scal(props)
-        if n_walls > 31:
-            raise WheelsoilInputError(f"{n_walls} walls: at most 31 planar walls are supported")
         d["xi_wall"] = ti.Vector.ndarray(3, ti.f64, shape=(n, max(n_walls, 1)))
         d["xi_wall"].fill(0.0)
         d["wall_touching"] = ti.ndarray(ti.i32, shape=n)

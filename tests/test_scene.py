@@ -201,3 +201,12 @@ def test_structural_edits_keep_pair_history_and_dynamics():
     assert n_pairs_before > 100 and reference.contact_count > 100
     np.testing.assert_allclose(edited.positions[: len(r)], reference.positions[1:], rtol=0, atol=1e-12)
     np.testing.assert_allclose(edited.angular_velocities[: len(r)], reference.angular_velocities[1:], rtol=0, atol=1e-9)
+
+
+def test_too_many_walls_is_refused_when_added():
+    s = Scene((0, 0, 0), (1, 1, 1))
+    for k in range(31):
+        s.add_wall((0, 0, 0), (0, 0, 1))
+    with pytest.raises(WheelsoilInputError, match="at most 31 planar walls"):
+        s.add_wall((0, 0, 0), (0, 0, 1))
+    assert len(s.walls) == 31
