@@ -56,7 +56,7 @@ def reference_workload_seconds(repeats: int = 5) -> float:
     global _reference_kernel
     import taichi as ti
 
-    from wheelsoil.granular import runtime
+    from wheelsoil import runtime
 
     runtime.init()
     if _reference_kernel is None:

@@ -100,7 +100,7 @@ def measure_dem(steps: int = 4000, warmup: int = 100) -> dict:
 
 
 def run_smoke() -> dict:
-    from wheelsoil.granular import runtime
+    from wheelsoil import runtime
     from wheelsoil.provenance import git_revision
 
     runtime.init()

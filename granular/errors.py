@@ -1,17 +1,5 @@
-"""Exceptions raised by the soil solver.
+"""Exceptions of the soil solver (shared with the rest of the package; defined in ``wheelsoil.errors``)."""
 
-Every error names the offending quantity, its value and what would have been accepted, so that a
-user can fix the input without reading a traceback.
-"""
+from wheelsoil.errors import CapacityError, SimulationUnstableError, WheelsoilInputError
 
-
-class WheelsoilInputError(ValueError):
-    """Bad user input: a parameter outside its allowed range, NaN in an array, a shape mismatch."""
-
-
-class SimulationUnstableError(RuntimeError):
-    """A run went unstable (NaN, energy blow-up, particles escaping the domain) and was stopped."""
-
-
-class CapacityError(RuntimeError):
-    """A fixed-size buffer (e.g. the per-particle neighbour list) overflowed."""
+__all__ = ["CapacityError", "SimulationUnstableError", "WheelsoilInputError"]

@@ -7,7 +7,7 @@ os.environ.setdefault("WHEELSOIL_ARCH", "cpu")
 
 @pytest.fixture(scope="session", autouse=True)
 def taichi_runtime():
-    from wheelsoil.granular import runtime
+    from wheelsoil import runtime
 
     runtime.init()
     yield

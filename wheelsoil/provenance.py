@@ -54,7 +54,7 @@ def provenance() -> dict:
     import taichi as ti
 
     from wheelsoil import __version__
-    from wheelsoil.granular.runtime import current_arch
+    from wheelsoil.runtime import current_arch
 
     return {
         "version": __version__,

@@ -1,0 +1,120 @@
+"""Corotational 3-D Euler-Bernoulli beam: set-up (NumPy) and internal forces (Taichi).
+
+Same EICR recipe as the shell (see ``shell.py``), after Crisfield (1990), CMAME 81, 131-150:
+
+* current frame: e1 along the chord x_1 - x_0; e2, e3 from the reference section axes carried by the
+  mean nodal rotation R_m = R_0 exp(1/2 log(R_0^T R_1));
+* deformational rotations theta_a = log(T^T R_a T0); axial stretch u = (l^2 - L^2) / (l + L);
+* local small-strain beam (Przemieniecki, *Theory of Matrix Structural Analysis*, sec. 5.6):
+      N = EA u / L,  M_x = GJ (theta_1x - theta_0x) / L,
+      [M_0y, M_1y] = EI_y / L [[4, 2], [2, 4]] [theta_0y, theta_1y]   (same for z with EI_z);
+* moments through H(theta_a)^T and the projector P = I - Psi G with the spin-lever
+      omega_z = (v_1 - v_0) / l,  omega_y = -(w_1 - w_0) / l,  omega_x = (theta_0x + theta_1x) / 2,
+  which supplies the shear forces (M_0 + M_1) / l that balance the end moments.
+"""
+
+
+import numpy as np
+import taichi as ti
+
+from .rotation import exp_so3, log_so3, mat3, spin_jacobian_inverse, vec3
+
+vec4 = ti.types.vector(4, ti.f64)
+ivec2 = ti.types.vector(2, ti.i32)
+nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
+nd_vec4 = ti.types.ndarray(dtype=vec4, ndim=1)
+nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
+nd_ivec2 = ti.types.ndarray(dtype=ivec2, ndim=1)
+nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
+
+
+def rectangular_section(width: float, height: float) -> tuple[float, float, float, float]:
+    """(A, I_y, I_z, J) [m^2, m^4] of a solid rectangle; ``width`` along local y, ``height`` along z.
+
+    I_y = w h^3 / 12 resists bending in the x-z plane. J is Roark's approximation for a rectangle,
+    J = a b^3 (1/3 - 0.21 (b/a) (1 - b^4 / (12 a^4))) with a >= b the long and short sides.
+    """
+    a, b = max(width, height), min(width, height)
+    j = a * b**3 * (1.0 / 3.0 - 0.21 * (b / a) * (1.0 - b**4 / (12.0 * a**4)))
+    return width * height, width * height**3 / 12.0, height * width**3 / 12.0, j
+
+
+def beam_frames(nodes: np.ndarray, beams: np.ndarray, orientation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reference frames (n, 3, 3; columns e1, e2, e3) and lengths; e2 is ``orientation`` made normal to e1."""
+    d = nodes[beams[:, 1]] - nodes[beams[:, 0]]
+    length = np.linalg.norm(d, axis=1)
+    e1 = d / length[:, None]
+    e2 = orientation - np.sum(orientation * e1, axis=1)[:, None] * e1
+    e2 /= np.linalg.norm(e2, axis=1)[:, None]
+    e3 = np.cross(e1, e2)
+    return np.stack([e1, e2, e3], axis=2), length
+
+
+def beam_section_stiffness(section: np.ndarray, material) -> np.ndarray:
+    """(EA, GJ, EI_y, EI_z) per beam from (A, I_y, I_z, J)."""
+    e, g = material.youngs_modulus, material.shear_modulus
+    return np.stack([e * section[:, 0], g * section[:, 3], e * section[:, 1], e * section[:, 2]], axis=1)
+
+
+@ti.func
+def beam_element(
+    e: ti.i32, x: ti.template(), rot: ti.template(), ends: ti.template(), frame0: ti.template(),
+    length0: ti.template(), rigidity: ti.template(), slot_f: ti.template(), slot_m: ti.template(),
+    slot_base: ti.i32, write: ti.i32,
+) -> ti.f64:
+    """Internal forces of beam e into its two slots (if ``write``); returns its strain energy [J]."""
+    n0, n1 = ends[e][0], ends[e][1]
+    d = x[n1] - x[n0]
+    l = d.norm()
+    e1 = d / l
+    r0, r1 = rot[n0], rot[n1]
+    rm = r0 @ exp_so3(0.5 * log_so3(r0.transpose() @ r1))
+    q = rm @ ti.Vector([frame0[e][0, 1], frame0[e][1, 1], frame0[e][2, 1]])
+    e3 = e1.cross(q).normalized()
+    t = ti.Matrix.cols([e1, e3.cross(e1), e3])
+    tt = t.transpose()
+    th0 = log_so3(tt @ r0 @ frame0[e])
+    th1 = log_so3(tt @ r1 @ frame0[e])
+    big_l = length0[e]
+    k = rigidity[e] / big_l  # EA/L, GJ/L, EIy/L, EIz/L
+    u = (l * l - big_l * big_l) / (l + big_l)
+    n_ax = k[0] * u
+    mx = k[1] * (th1[0] - th0[0])
+    my0 = k[2] * (4.0 * th0[1] + 2.0 * th1[1])
+    my1 = k[2] * (2.0 * th0[1] + 4.0 * th1[1])
+    mz0 = k[3] * (4.0 * th0[2] + 2.0 * th1[2])
+    mz1 = k[3] * (2.0 * th0[2] + 4.0 * th1[2])
+    energy = 0.5 * (n_ax * u + mx * (th1[0] - th0[0]) + my0 * th0[1] + my1 * th1[1] + mz0 * th0[2] + mz1 * th1[2])
+    if write:
+        m0 = spin_jacobian_inverse(th0).transpose() @ vec3(-mx, my0, mz0)
+        m1 = spin_jacobian_inverse(th1).transpose() @ vec3(mx, my1, mz1)
+        mtot = m0 + m1  # the axial forces are collinear with the chord: no moment
+        f0 = vec3(-n_ax, mtot[2] / l, -mtot[1] / l)
+        f1 = vec3(n_ax, -mtot[2] / l, mtot[1] / l)
+        m0 -= vec3(0.5 * mtot[0], 0.0, 0.0)
+        m1 -= vec3(0.5 * mtot[0], 0.0, 0.0)
+        slot_f[slot_base + 2 * e] = -(t @ f0)
+        slot_f[slot_base + 2 * e + 1] = -(t @ f1)
+        slot_m[slot_base + 2 * e] = -(t @ m0)
+        slot_m[slot_base + 2 * e + 1] = -(t @ m1)
+    return energy
+
+
+@ti.kernel
+def beam_forces(
+    x: nd_vec3, rot: nd_mat3, ends: nd_ivec2, frame0: nd_mat3, length0: nd_f64, rigidity: nd_vec4,
+    slot_f: nd_vec3, slot_m: nd_vec3, slot_base: ti.i32,
+):
+    """Internal nodal forces and moments of every beam (one slot per beam end)."""
+    for e in ends:
+        beam_element(e, x, rot, ends, frame0, length0, rigidity, slot_f, slot_m, slot_base, 1)
+
+
+@ti.kernel
+def beam_energies(
+    x: nd_vec3, rot: nd_mat3, ends: nd_ivec2, frame0: nd_mat3, length0: nd_f64, rigidity: nd_vec4,
+    slot_f: nd_vec3, slot_m: nd_vec3, energy: nd_f64,
+):
+    """Strain energy of every beam [J]."""
+    for e in ends:
+        energy[e] = beam_element(e, x, rot, ends, frame0, length0, rigidity, slot_f, slot_m, 0, 0)

@@ -1,0 +1,61 @@
+"""Finite rotations for the corotational elements (Taichi functions).
+
+Node orientations are 3x3 rotation matrices updated by the exponential map; deformational rotations
+are small rotation vectors extracted by the logarithm. ``spin_jacobian_inverse`` is the matrix H of
+Felippa & Haugen (2005), CMAME 194, eq. (4.3)/(4.4): for R = exp(spin(theta)) and a left spin
+variation dR = spin(d omega) R, d theta = H(theta) d omega with
+    H = I - 1/2 Theta + eta Theta^2,   eta = (1 - (g/2) cot(g/2)) / g^2,   g = |theta|.
+"""
+
+import taichi as ti
+
+vec3 = ti.types.vector(3, ti.f64)
+mat3 = ti.types.matrix(3, 3, ti.f64)
+
+
+@ti.func
+def spin(a: vec3) -> mat3:
+    """Skew matrix with spin(a) b = a x b."""
+    return mat3([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+@ti.func
+def exp_so3(theta: vec3) -> mat3:
+    """Rodrigues: exp(spin(theta)), with series for small angles."""
+    g2 = theta.dot(theta)
+    s = spin(theta)
+    a = 1.0
+    b = 0.5
+    if g2 < 1e-8:
+        a = 1.0 - g2 / 6.0
+        b = 0.5 - g2 / 24.0
+    else:
+        g = ti.sqrt(g2)
+        a = ti.sin(g) / g
+        b = (1.0 - ti.cos(g)) / g2
+    return ti.Matrix.identity(ti.f64, 3) + a * s + b * (s @ s)
+
+
+@ti.func
+def log_so3(r: mat3) -> vec3:
+    """Rotation vector theta with exp(spin(theta)) = r, for |theta| < pi."""
+    w = 0.5 * vec3(r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1])  # sin(g) * axis
+    s = w.norm()
+    c = 0.5 * (r[0, 0] + r[1, 1] + r[2, 2] - 1.0)
+    g = ti.atan2(s, c)
+    factor = 1.0 + g * g / 6.0
+    if s > 1e-6:
+        factor = g / s
+    return factor * w
+
+
+@ti.func
+def spin_jacobian_inverse(theta: vec3) -> mat3:
+    """H(theta) = d theta / d omega (see module docstring)."""
+    g2 = theta.dot(theta)
+    eta = 1.0 / 12.0 + g2 / 720.0
+    if g2 > 1e-6:
+        g = ti.sqrt(g2)
+        eta = (1.0 - 0.5 * g / ti.tan(0.5 * g)) / g2
+    s = spin(theta)
+    return ti.Matrix.identity(ti.f64, 3) - 0.5 * s + eta * (s @ s)

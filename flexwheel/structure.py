@@ -1,0 +1,477 @@
+"""The FE structure on the device: state, stable time step, sub-stepping and the rigid hub.
+
+:class:`Structure` is what the coupling talks to. Given nodal forces held over an interval, it advances
+the structure over that interval in stable sub-steps (:meth:`Structure.advance`) and reports node
+positions, velocities and the surface triangles. A set of nodes can be tied to a rigid *hub* whose
+six degrees of freedom are each prescribed (kinematic drive) or free (force drive); a clamped support
+is a hub held still. ``rigid=True`` ties every node to the hub: the rigid-wheel variant with the same
+surface.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import taichi as ti
+
+from wheelsoil import runtime
+from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
+
+from . import integrator as itg
+from . import stepper
+from .beam import beam_energies, beam_forces, beam_frames, beam_section_stiffness
+from .mesh import StructureMesh
+from .rotation import mat3, vec3
+from .shell import mat9, mat32, shell_energies, shell_forces, shell_setup
+
+#: Fraction of the critical central-difference step used by default.
+DEFAULT_SAFETY = 0.9
+
+
+def _nd(dtype, values) -> ti.Ndarray:
+    """A Taichi ndarray holding ``values`` (element shape taken from ``dtype``)."""
+    values = np.ascontiguousarray(values)
+    if values.shape[0] == 0:  # Taichi has no empty arrays; kernels are never launched over these
+        values = np.zeros((1,) + values.shape[1:], dtype=values.dtype)
+    elem_ndim = getattr(dtype, "ndim", 0)
+    arr = ti.ndarray(dtype=dtype, shape=values.shape[: values.ndim - elem_ndim])
+    arr.from_numpy(values)
+    return arr
+
+
+def _vec(values):
+    return _nd(vec3, np.asarray(values, float).reshape(-1, 3))
+
+
+def critical_frequency(mesh: StructureMesh) -> np.ndarray:
+    """Largest circular frequency [rad/s] of every element with its own lumped mass (facets, then beams).
+
+    The largest frequency of the assembled, lumped-mass system never exceeds the largest element one
+    (Irons' element eigenvalue theorem; Hughes, *The Finite Element Method*, sec. 9.1), so the
+    central-difference limit dt < 2 / omega_max computed from these is safe.
+    """
+    fm, fi, bm, bi = mesh.element_masses()
+    out = []
+    if len(mesh.triangles):
+        _, _, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
+        inv_m = 1.0 / np.sqrt(np.stack([fm, fm, fi] * 3, axis=1))
+        inv_b = 1.0 / np.sqrt(np.stack([fm, fi, fi] * 3, axis=1))
+        lam_m = np.linalg.eigvalsh(km * inv_m[:, :, None] * inv_m[:, None, :])[:, -1]
+        lam_b = np.linalg.eigvalsh(kb * inv_b[:, :, None] * inv_b[:, None, :])[:, -1]
+        out.append(np.sqrt(np.maximum(lam_m, lam_b)))
+    if len(mesh.beams):
+        rig = beam_section_stiffness(mesh.beam_section, mesh.material)
+        length = mesh.beam_lengths()
+        lam = np.maximum(2.0 * rig[:, 0] / (length * bm), 2.0 * rig[:, 1] / (length * bi))
+        for ei in (rig[:, 2], rig[:, 3]):
+            k = np.zeros((len(length), 4, 4))
+            L = length
+            entries = {(0, 0): 12, (0, 1): 6 * L, (0, 2): -12, (0, 3): 6 * L, (1, 1): 4 * L**2,
+                       (1, 2): -6 * L, (1, 3): 2 * L**2, (2, 2): 12, (2, 3): -6 * L, (3, 3): 4 * L**2}
+            for (i, j), val in entries.items():
+                k[:, i, j] = k[:, j, i] = val * ei / L**3
+            s = 1.0 / np.sqrt(np.stack([bm, bi, bm, bi], axis=1))
+            lam = np.maximum(lam, np.linalg.eigvalsh(k * s[:, :, None] * s[:, None, :])[:, -1])
+        out.append(np.sqrt(lam))
+    return np.concatenate(out)
+
+
+class Structure:
+    """A shell/beam structure advanced by explicit central differences on Taichi.
+
+    Parameters
+    ----------
+    mesh: the :class:`StructureMesh`.
+    hub_nodes: indices of the nodes rigidly tied to the hub (none: no hub).
+    hub_center: reference point of the hub [m] (default: centroid of the hub nodes).
+    hub_mass, hub_inertia: the hub's own mass [kg] and principal inertia (Ixx, Iyy, Izz) [kg m^2],
+        added to those of its nodes.
+    rigid: tie every node to the hub (rigid variant: no element is evaluated).
+    damping: mass-proportional damping coefficient a [1/s] (force -a m v on every node).
+    gravity: acceleration of gravity [m/s^2] (vector).
+    safety: fraction of the critical step used by :meth:`advance` (0 < safety <= 1).
+    arch: Taichi backend (see :func:`wheelsoil.runtime.init`).
+    serial: run whole batches of steps in one serial kernel launch (default: for meshes of at most
+        ``SERIAL_ELEMENT_LIMIT`` elements, where parallel-loop dispatch costs more than the work).
+    """
+
+    SERIAL_ELEMENT_LIMIT = 2000
+    MAX_STEPS_PER_LAUNCH = 20_000
+
+    def __init__(
+        self,
+        mesh: StructureMesh,
+        *,
+        hub_nodes=None,
+        hub_center=None,
+        hub_mass: float = 0.0,
+        hub_inertia=(0.0, 0.0, 0.0),
+        rigid: bool = False,
+        damping: float = 0.0,
+        gravity=(0.0, 0.0, 0.0),
+        safety: float = DEFAULT_SAFETY,
+        arch: str | None = None,
+        serial: bool | None = None,
+    ) -> None:
+        self.arch = runtime.init(arch)
+        self.mesh = mesh
+        n = mesh.n_nodes
+        if not (0.0 < safety <= 1.0):
+            raise WheelsoilInputError(f"safety={safety!r} must lie in (0, 1]")
+        if not (math.isfinite(damping) and damping >= 0.0):
+            raise WheelsoilInputError(f"damping={damping!r} 1/s must be finite and >= 0")
+        self.safety = float(safety)
+        self.damping = float(damping)
+        self.gravity = np.asarray(gravity, float).reshape(3)
+        self.rigid = bool(rigid)
+        hub = np.arange(n) if rigid else np.unique(np.asarray(hub_nodes if hub_nodes is not None else [], np.int64))
+        if hub.size and (hub.min() < 0 or hub.max() >= n):
+            raise WheelsoilInputError(f"hub_nodes refer to node {hub.max()}, but the mesh has {n} nodes")
+        if rigid and hub_nodes is not None and len(hub_nodes) == 0:
+            raise WheelsoilInputError("a rigid structure needs its hub")
+        self.hub_nodes = hub
+        self.mass, self.inertia = mesh.lumped_mass()
+        tied = np.zeros(n, bool)
+        tied[hub] = True
+        loose = np.flatnonzero((self.mass <= 0) & ~tied)
+        if loose.size:
+            raise WheelsoilInputError(f"node {loose[0]} belongs to no element (and is not tied to the hub)")
+        if hub_mass < 0 or any(i < 0 for i in hub_inertia):
+            raise WheelsoilInputError(f"hub_mass={hub_mass!r} and hub_inertia={tuple(hub_inertia)!r} must be >= 0")
+
+        # ---- element data
+        self.n_facets, self.n_beams = len(mesh.triangles), len(mesh.beams)
+        self._slot_beam_base = 3 * self.n_facets
+        n_slots = 3 * self.n_facets + 2 * self.n_beams
+        d = {}
+        if self.n_facets:
+            frames, local, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
+            d["tri"] = _nd(ti.types.vector(3, ti.i32), mesh.triangles.astype(np.int32))
+            d["frame0"] = _nd(mat3, frames)
+            d["local0"] = _nd(mat32, local)
+            d["km"] = _nd(mat9, km)
+            d["kb"] = _nd(mat9, kb)
+        else:
+            d["tri"] = _nd(ti.types.vector(3, ti.i32), np.zeros((1, 3), np.int32))
+            d["frame0"] = _nd(mat3, np.eye(3)[None])
+            d["local0"] = _nd(mat32, np.zeros((1, 3, 2)))
+            d["km"] = _nd(mat9, np.zeros((1, 9, 9)))
+            d["kb"] = _nd(mat9, np.zeros((1, 9, 9)))
+        if self.n_beams:
+            bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
+            d["ends"] = _nd(ti.types.vector(2, ti.i32), mesh.beams.astype(np.int32))
+            d["bframe0"] = _nd(mat3, bframes)
+            d["blen0"] = _nd(ti.f64, blen)
+            d["rigidity"] = _nd(ti.types.vector(4, ti.f64), beam_section_stiffness(mesh.beam_section, mesh.material))
+        else:
+            d["ends"] = _nd(ti.types.vector(2, ti.i32), np.array([[0, 0]], np.int32))
+            d["bframe0"] = _nd(mat3, np.eye(3)[None])
+            d["blen0"] = _nd(ti.f64, np.ones(1))
+            d["rigidity"] = _nd(ti.types.vector(4, ti.f64), np.zeros((1, 4)))
+        slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
+        order = np.argsort(slot_node, kind="stable")
+        start = np.zeros(n + 1, np.int32)
+        np.add.at(start, slot_node + 1, 1)
+        d["slot_start"] = _nd(ti.i32, np.cumsum(start).astype(np.int32))
+        d["slot_list"] = _nd(ti.i32, order.astype(np.int32))
+        d["slot_f"] = _vec(np.zeros((n_slots, 3)))
+        d["slot_m"] = _vec(np.zeros((n_slots, 3)))
+
+        # ---- node state
+        d["x"] = _vec(mesh.nodes)
+        d["v"] = _vec(np.zeros((n, 3)))
+        d["rot"] = _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3)))
+        d["w"] = _vec(np.zeros((n, 3)))
+        d["mass"] = _nd(ti.f64, np.where(self.mass > 0, self.mass, 1.0))
+        d["inertia"] = _nd(ti.f64, np.where(self.inertia > 0, self.inertia, 1.0))
+        d["free"] = _nd(ti.i32, (~tied).astype(np.int32))
+        d["f_ext"] = _vec(np.zeros((n, 3)))
+        d["m_ext"] = _vec(np.zeros((n, 3)))
+        d["f_tot"] = _vec(np.zeros((n, 3)))
+        d["m_tot"] = _vec(np.zeros((n, 3)))
+        d["peak"] = _nd(ti.f64, np.zeros(2))
+        self._dev = d
+
+        # ---- hub
+        self.hub_center0 = (
+            np.asarray(hub_center, float).reshape(3)
+            if hub_center is not None
+            else (mesh.nodes[hub].mean(axis=0) if hub.size else np.zeros(3))
+        )
+        if not hub.size:  # placeholders: the kernels take them but never read them
+            d["hub_nodes"] = _nd(ti.i32, np.zeros(1, np.int32))
+            d["hub_offset"] = _vec(np.zeros((1, 3)))
+            d["hub"] = _vec(np.zeros((itg.HUB_ROWS, 3)))
+            d["hub_rot"] = _nd(mat3, np.eye(3)[None])
+            d["hub_scalar"] = _nd(ti.f64, np.zeros(2))
+        else:
+            d["hub_nodes"] = _nd(ti.i32, hub.astype(np.int32))
+            d["hub_offset"] = _vec(mesh.nodes[hub] - self.hub_center0)
+            state = np.zeros((itg.HUB_ROWS, 3))
+            state[itg.HUB_POSITION] = self.hub_center0
+            state[itg.HUB_OWN_INERTIA] = np.asarray(hub_inertia, float)
+            d["hub"] = _vec(state)
+            d["hub_rot"] = _nd(mat3, np.eye(3)[None])
+            d["hub_scalar"] = _nd(ti.f64, np.array([float(hub_mass), 0.0]))
+        self.hub_mass_total = float(hub_mass + self.mass[hub].sum())
+
+        # ---- time step
+        if rigid or n_slots == 0:
+            self.critical_time_step = math.inf
+        else:
+            omega = float(critical_frequency(mesh).max())
+            zeta = self.damping / (2.0 * omega)
+            self.critical_time_step = 2.0 / omega * (math.sqrt(1.0 + zeta**2) - zeta)
+        self.time = 0.0
+        self.steps_taken = 0
+        self.serial = (mesh.n_elements <= self.SERIAL_ELEMENT_LIMIT) if serial is None else bool(serial)
+
+    # ------------------------------------------------------------------ time stepping
+    @property
+    def stable_time_step(self) -> float:
+        """Largest step :meth:`advance` will use: ``safety`` times the critical step [s]."""
+        return self.safety * self.critical_time_step
+
+    def set_external(self, forces=None, moments=None) -> None:
+        """Nodal external forces [N] and moments [N m], (N, 3) arrays held until changed (None: zero)."""
+        n = self.mesh.n_nodes
+        for key, val, name in (("f_ext", forces, "forces"), ("m_ext", moments, "moments")):
+            arr = np.zeros((n, 3)) if val is None else np.asarray(val, float)
+            if arr.shape != (n, 3):
+                raise WheelsoilInputError(f"external {name} must have shape ({n}, 3), got {arr.shape}")
+            if not np.all(np.isfinite(arr)):
+                raise WheelsoilInputError(f"external {name} contain NaN or inf (first at node {np.argwhere(~np.isfinite(arr))[0][0]})")
+            self._dev[key].from_numpy(arr)
+
+    def step(self, n_steps: int = 1, dt: float | None = None, *, kinetic_damping: bool = False) -> None:
+        """Advance ``n_steps`` central-difference steps of size ``dt`` (default: the stable step).
+
+        ``kinetic_damping`` zeroes the free nodes' velocities whenever the kinetic energy passes a
+        maximum (static relaxation, see :mod:`wheelsoil.flexwheel.statics`).
+        """
+        dt = self.stable_time_step if dt is None else float(dt)
+        if not math.isfinite(dt):
+            raise WheelsoilInputError("a rigid structure has no stable step of its own: give dt")
+        if not (0.0 < dt <= self.critical_time_step * (1.0 + 1e-12)):
+            raise WheelsoilInputError(
+                f"time step dt={dt:.4g} s exceeds the structure's critical step {self.critical_time_step:.4g} s "
+                f"(largest element frequency); use dt <= {self.stable_time_step:.4g} s"
+            )
+        n_steps = int(n_steps)
+        if n_steps <= 0:
+            return
+        d = self._dev
+        g = vec3(*self.gravity)
+        n_facets = 0 if self.rigid else self.n_facets
+        n_beams = 0 if self.rigid else self.n_beams
+        n_hub = len(self.hub_nodes)
+        if self.serial:
+            counts = ti.Vector([self.mesh.n_nodes, n_facets, n_beams, n_hub], ti.i32)
+            for done in range(0, n_steps, self.MAX_STEPS_PER_LAUNCH):
+                stepper.steps_serial(
+                    min(self.MAX_STEPS_PER_LAUNCH, n_steps - done), dt, self.damping, g, int(kinetic_damping), counts,
+                    d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"], d["free"], d["f_ext"], d["m_ext"],
+                    d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"], d["f_tot"], d["m_tot"],
+                    d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
+                    d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
+                    d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"], d["hub_scalar"], d["peak"],
+                )
+        else:
+            for _ in range(n_steps):
+                if n_facets:
+                    shell_forces(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
+                                 d["slot_f"], d["slot_m"], 0)
+                if n_beams:
+                    beam_forces(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
+                                d["slot_f"], d["slot_m"], self._slot_beam_base)
+                stepper.nodes_parallel(
+                    self.mesh.n_nodes, dt, self.damping, g, d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
+                    d["free"], d["f_ext"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
+                    d["f_tot"], d["m_tot"])
+                if n_hub:
+                    stepper.hub_parallel(n_hub, dt, g, d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"],
+                                         d["hub_scalar"], d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
+                                         d["f_tot"], d["m_tot"])
+                if kinetic_damping:
+                    itg.kinetic_damping(self.mesh.n_nodes, d["v"], d["w"], d["mass"], d["inertia"], d["free"], d["peak"])
+        self.time += dt * n_steps
+        self.steps_taken += n_steps
+
+    def advance(self, interval: float, forces=None, moments=None, *, check: bool = True) -> int:
+        """Advance by ``interval`` seconds in equal sub-steps no larger than the stable step.
+
+        ``forces``/``moments`` (N, 3), if given, replace the external nodal loads and are held over the
+        interval. Returns the number of sub-steps taken. Raises :class:`SimulationUnstableError` if the
+        state is no longer finite afterwards.
+        """
+        if not (math.isfinite(interval) and interval > 0):
+            raise WheelsoilInputError(f"interval={interval!r} s must be finite and > 0")
+        if forces is not None or moments is not None:
+            self.set_external(forces, moments)
+        n_sub = 1 if not math.isfinite(self.stable_time_step) else max(1, math.ceil(interval / self.stable_time_step * (1 - 1e-12)))
+        dt = interval / n_sub
+        if not math.isfinite(self.critical_time_step):
+            self.critical_time_step = dt  # rigid: any step is stable
+        self.step(n_sub, dt)
+        if check:
+            self.check_health()
+        return n_sub
+
+    def check_health(self) -> None:
+        """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
+        worst = itg.max_speed_squared(self._dev["v"], self._dev["w"])
+        limit = 1e3 * self.mesh.material.wave_speed
+        if not worst < limit**2:
+            raise SimulationUnstableError(
+                f"the wheel structure went unstable at t={self.time:.6g} s: node speed "
+                f"{math.sqrt(worst) if worst < 1e300 else float('nan'):.3g} m/s (limit {limit:.3g} m/s, NaN means "
+                "non-finite state). Reduce the time step (safety) or the loads."
+            )
+
+    # ------------------------------------------------------------------ hub
+    def _hub_state(self) -> np.ndarray:
+        if not self.hub_nodes.size:
+            raise WheelsoilInputError("this structure has no hub")
+        return self._dev["hub"].to_numpy()
+
+    def drive_hub(self, *, velocity=None, angular_velocity=None, free_translation=None, free_rotation=None,
+                  force=None, moment=None) -> None:
+        """Set the hub's drive, held until changed.
+
+        velocity, angular_velocity: prescribed velocity [m/s] and spin [rad/s] (global frame) of the
+            prescribed degrees of freedom.
+        free_translation, free_rotation: three booleans each; True makes that dof force-driven.
+        force, moment: load the rig applies to the hub [N, N m] (acts on the free dofs; on prescribed
+            ones it only changes the reported reaction).
+        """
+        s = self._hub_state()
+        for row, val in ((itg.HUB_CMD_VELOCITY, velocity), (itg.HUB_CMD_SPIN, angular_velocity),
+                         (itg.HUB_APPLIED_FORCE, force), (itg.HUB_APPLIED_MOMENT, moment)):
+            if val is not None:
+                arr = np.asarray(val, float).reshape(3)
+                if not np.all(np.isfinite(arr)):
+                    raise WheelsoilInputError(f"hub drive value {arr.tolist()} must be finite")
+                s[row] = arr
+        for row, val in ((itg.HUB_FREE_TRANSLATION, free_translation), (itg.HUB_FREE_ROTATION, free_rotation)):
+            if val is not None:
+                s[row] = np.asarray(val, bool).reshape(3).astype(float)
+        self._dev["hub"].from_numpy(s)
+
+    def set_hub_state(self, *, velocity=None, angular_velocity=None) -> None:
+        """Set the hub's current velocity and spin (e.g. to start a free dof moving)."""
+        s = self._hub_state()
+        if velocity is not None:
+            s[itg.HUB_VELOCITY] = np.asarray(velocity, float).reshape(3)
+        if angular_velocity is not None:
+            s[itg.HUB_SPIN] = np.asarray(angular_velocity, float).reshape(3)
+        self._dev["hub"].from_numpy(s)
+
+    @property
+    def hub_position(self) -> np.ndarray:
+        return self._hub_state()[itg.HUB_POSITION].copy()
+
+    @property
+    def hub_velocity(self) -> np.ndarray:
+        return self._hub_state()[itg.HUB_VELOCITY].copy()
+
+    @property
+    def hub_angular_velocity(self) -> np.ndarray:
+        return self._hub_state()[itg.HUB_SPIN].copy()
+
+    @property
+    def hub_rotation(self) -> np.ndarray:
+        self._hub_state()
+        return self._dev["hub_rot"].to_numpy()[0]
+
+    def hub_reaction(self, reset: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Mean force [N] and moment about the hub centre [N m] the rig applied to the prescribed hub
+        dofs since the last reset (zero on free dofs)."""
+        s = self._hub_state()
+        scal = self._dev["hub_scalar"].to_numpy()
+        k = max(scal[itg.HUB_SAMPLES], 1.0)
+        f, m = s[itg.HUB_REACTION_FORCE] / k, s[itg.HUB_REACTION_MOMENT] / k
+        if reset:
+            s[itg.HUB_REACTION_FORCE] = 0.0
+            s[itg.HUB_REACTION_MOMENT] = 0.0
+            scal[itg.HUB_SAMPLES] = 0.0
+            self._dev["hub"].from_numpy(s)
+            self._dev["hub_scalar"].from_numpy(scal)
+        return f, m
+
+    # ------------------------------------------------------------------ state out
+    def positions(self) -> np.ndarray:
+        """Node positions (N, 3) [m]."""
+        return self._dev["x"].to_numpy()
+
+    def velocities(self) -> np.ndarray:
+        """Node velocities (N, 3) [m/s] (at the last half step)."""
+        return self._dev["v"].to_numpy()
+
+    def angular_velocities(self) -> np.ndarray:
+        return self._dev["w"].to_numpy()
+
+    def rotations(self) -> np.ndarray:
+        """Node rotation matrices (N, 3, 3) from the reference configuration."""
+        return self._dev["rot"].to_numpy()
+
+    def displacements(self) -> np.ndarray:
+        return self.positions() - self.mesh.nodes
+
+    def nodal_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Total force and moment on every node at the last step (elastic + external + gravity)."""
+        return self._dev["f_tot"].to_numpy(), self._dev["m_tot"].to_numpy()
+
+    @property
+    def surface_triangles(self) -> np.ndarray:
+        """Node indices (S, 3) of the contact-surface facets."""
+        return self.mesh.triangles[self.mesh.surface]
+
+    def set_state(self, positions=None, velocities=None, rotations=None, angular_velocities=None) -> None:
+        """Overwrite node state arrays (for tests and restarts)."""
+        for key, val, shape in (("x", positions, (3,)), ("v", velocities, (3,)), ("rot", rotations, (3, 3)),
+                                ("w", angular_velocities, (3,))):
+            if val is not None:
+                arr = np.asarray(val, float)
+                if arr.shape != (self.mesh.n_nodes,) + shape or not np.all(np.isfinite(arr)):
+                    raise WheelsoilInputError(f"{key} must be a finite array of shape {(self.mesh.n_nodes,) + shape}")
+                self._dev[key].from_numpy(arr)
+
+    def internal_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Elastic nodal forces and moments (N, 3) of the current state (no step is taken)."""
+        d = self._dev
+        n = self.mesh.n_nodes
+        if self.rigid:
+            return np.zeros((n, 3)), np.zeros((n, 3))
+        if self.n_facets:
+            shell_forces(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"], d["slot_f"], d["slot_m"], 0)
+        if self.n_beams:
+            beam_forces(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"], d["slot_f"],
+                        d["slot_m"], self._slot_beam_base)
+        sf, sm = d["slot_f"].to_numpy(), d["slot_m"].to_numpy()
+        nodes = np.concatenate([self.mesh.triangles.reshape(-1), self.mesh.beams.reshape(-1)])
+        f, m = np.zeros((n, 3)), np.zeros((n, 3))
+        np.add.at(f, nodes, sf[: len(nodes)])
+        np.add.at(m, nodes, sm[: len(nodes)])
+        return f, m
+
+    def strain_energy(self) -> float:
+        """Elastic energy stored in the elements [J]."""
+        if self.rigid:
+            return 0.0
+        d = self._dev
+        total = 0.0
+        if self.n_facets:
+            e = ti.ndarray(ti.f64, shape=self.n_facets)
+            shell_energies(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"], d["slot_f"], d["slot_m"], e)
+            total += float(e.to_numpy().sum())
+        if self.n_beams:
+            e = ti.ndarray(ti.f64, shape=self.n_beams)
+            beam_energies(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"], d["slot_f"], d["slot_m"], e)
+            total += float(e.to_numpy().sum())
+        return total
+
+    def kinetic_energy(self) -> float:
+        """1/2 sum m v^2 + 1/2 sum I omega^2 over the nodes [J] (half-step velocities)."""
+        d = self._dev
+        return float(itg.kinetic_energy(self.mesh.n_nodes, d["v"], d["w"], d["mass"], d["inertia"]))

@@ -1,0 +1,82 @@
+"""Taichi runtime set-up shared by every solver in the package.
+
+Taichi is initialised once per process. The offline kernel cache is on (kernels compiled once are
+reused by later processes), and its location can be moved with ``WHEELSOIL_TAICHI_CACHE``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import taichi as ti
+
+from .errors import WheelsoilInputError
+
+_ARCHES = {
+    "cpu": ti.cpu,
+    "cuda": ti.cuda,
+    "gpu": ti.gpu,
+    "vulkan": ti.vulkan,
+    "metal": ti.metal,
+}
+
+_state: dict = {"arch": None, "init_seconds": None}
+
+
+def default_cache_dir() -> Path:
+    """Root folder for wheelsoil's caches (``WHEELSOIL_CACHE`` or ``~/.cache/wheelsoil``)."""
+    root = os.environ.get("WHEELSOIL_CACHE")
+    return Path(root) if root else Path.home() / ".cache" / "wheelsoil"
+
+
+def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | None = None) -> str:
+    """Initialise Taichi for wheelsoil (idempotent).
+
+    Parameters
+    ----------
+    arch:
+        ``"cpu"`` (default, also taken from ``WHEELSOIL_ARCH``), ``"cuda"``, ``"gpu"``, ``"vulkan"`` or
+        ``"metal"``. Asking for a different backend after the first initialisation is an error, because
+        every array already allocated lives on the first one.
+    cpu_threads:
+        Number of CPU threads for parallel loops (default: all cores).
+
+    Returns the name of the backend actually in use.
+    """
+    requested = (arch or os.environ.get("WHEELSOIL_ARCH") or "cpu").lower()
+    if requested not in _ARCHES:
+        raise WheelsoilInputError(
+            f"arch={requested!r} is not a Taichi backend wheelsoil knows; choose one of {sorted(_ARCHES)}"
+        )
+    if _state["arch"] is not None:
+        if arch is not None and requested != _state["arch"]:
+            raise WheelsoilInputError(
+                f"Taichi is already running on arch={_state['arch']!r} in this process; "
+                f"arch={requested!r} cannot be selected now (start a new process)"
+            )
+        return _state["arch"]
+    cache = Path(os.environ.get("WHEELSOIL_TAICHI_CACHE", default_cache_dir() / "taichi"))
+    cache.mkdir(parents=True, exist_ok=True)
+    kwargs = dict(
+        arch=_ARCHES[requested],
+        default_fp=ti.f64,
+        default_ip=ti.i32,
+        offline_cache=True,
+        offline_cache_file_path=str(cache),
+        debug=debug,
+        log_level=ti.WARN,
+    )
+    if cpu_threads is not None:
+        kwargs["cpu_max_num_threads"] = int(cpu_threads)
+    t0 = time.perf_counter()
+    ti.init(**kwargs)
+    _state["init_seconds"] = time.perf_counter() - t0
+    _state["arch"] = requested
+    return requested
+
+
+def current_arch() -> str | None:
+    """Backend Taichi was initialised with, or ``None`` before :func:`init`."""
+    return _state["arch"]
