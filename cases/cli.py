@@ -115,7 +115,124 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-liggghts", action="store_true", help="full tier: skip the LIGGGHTS comparison")
     p.add_argument("--memory-check", action="store_true", help="full tier: also step a seed-004-size bed")
     p.set_defaults(func=cmd_bench)
+    p = sub.add_parser("wheel", help="mesh a preset wheel and load-test it against a flat plate",
+                       description="Mesh a preset wheel (lunar-rover: seed 004; exomars: seeds 000/001), write the "
+                                   "mesh as VTU, and measure its radial stiffness: point-load stiffness at angles "
+                                   "over one spoke pitch, and the load-deflection curve against a rigid flat plate "
+                                   "over the spoke and midway between spokes. Writes mesh.vtu, load_test.csv, "
+                                   "load_test.png and summary.json to --out.")
+    p.add_argument("preset", help="wheel preset: lunar-rover or exomars")
+    p.add_argument("--element-size", type=float, default=None, help="target element edge [m] (default: the preset's)")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/wheel-<preset>)")
+    p.add_argument("--points", type=int, default=6, help="load steps of the plate curve (default 6)")
+    p.add_argument("--max-load-factor", type=float, default=1.5,
+                   help="largest plate load as a multiple of the preset's nominal load (default 1.5)")
+    p.set_defaults(func=cmd_wheel)
     return parser
+
+
+def cmd_wheel(args) -> int:
+    import json
+
+    import numpy as np
+
+    from wheelsoil.flexwheel.geometry import build_wheel_mesh, preset
+    from wheelsoil.flexwheel.loadtest import plate_load_curve, point_load_stiffness
+    from wheelsoil.provenance import atomic_output, provenance
+
+    console = _console()
+    geometry = preset(args.preset)
+    if args.element_size is not None:
+        geometry = geometry.with_element_size(args.element_size)
+    if args.points < 2:
+        raise _InputError(f"--points={args.points} must be >= 2")
+    if not (args.max_load_factor > 0):
+        raise _InputError(f"--max-load-factor={args.max_load_factor} must be > 0")
+    out = args.out or Path("wheelsoil-output") / f"wheel-{geometry.name}"
+    mesh, hub = build_wheel_mesh(geometry)
+    mesh.write(out / "mesh.vtu")
+    console.print(f"[bold]{geometry.name}[/]: {mesh.n_nodes} nodes, {len(mesh.triangles)} facets, {len(mesh.beams)} beams, "
+                  f"{len(hub)} hub nodes, structure mass {mesh.total_mass:.3g} kg -> {out / 'mesh.vtu'}")
+    pitch = geometry.spoke_pitch
+    angles = np.linspace(0.0, pitch, 5)
+    with _progress(console) as bar:
+        task = bar.add_task("point-load stiffness", total=len(angles))
+        point = []
+        for a in angles:
+            point.append(point_load_stiffness(geometry, a))
+            bar.advance(task)
+        k_ref = min(point)
+        top = min(args.max_load_factor * max(geometry.nominal_load, 1.0) / k_ref, 0.2 * geometry.radius)
+        deflections = np.linspace(top / args.points, top, args.points)
+        curves = []
+        for a in (0.0, pitch / 2):
+            task = bar.add_task(f"plate curve at {a:g} deg", total=len(deflections))
+            curves.append(plate_load_curve(geometry, deflections, a, progress=lambda k, n, t=task: bar.update(t, completed=k)))
+    rows = ["angle_deg,deflection_m,force_N,contact_nodes"]
+    for c in curves:
+        rows += [f"{c.angle:g},{d:.6g},{f:.6g},{n}" for d, f, n in zip(c.deflection, c.force, c.contact_nodes)]
+    with atomic_output(out / "load_test.csv") as tmp:
+        tmp.write_text("\n".join(rows) + "\n")
+    nominal = {}
+    for c in curves:
+        if geometry.nominal_load and c.force[0] <= geometry.nominal_load <= c.force[-1]:
+            nominal[f"{c.angle:g}"] = c.stiffness_at(geometry.nominal_load)
+    summary = {
+        "preset": geometry.name,
+        "element_size_m": geometry.element_size,
+        "nodes": mesh.n_nodes,
+        "facets": int(len(mesh.triangles)),
+        "beams": int(len(mesh.beams)),
+        "structure_mass_kg": mesh.total_mass,
+        "spoke_pitch_deg": pitch,
+        "point_load_stiffness_N_per_m": {f"{a:g}": k for a, k in zip(angles, point)},
+        "point_load_stiffness_mean_N_per_m": float(np.mean(point)),
+        "nominal_load_N": geometry.nominal_load,
+        "plate_secant_stiffness_at_nominal_N_per_m": nominal,
+        "provenance": provenance(),
+    }
+    with atomic_output(out / "summary.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    _plot_load_curves(curves, geometry, out / "load_test.png")
+    console.print(f"point-load radial stiffness over one spoke pitch ({pitch:g} deg): "
+                  + ", ".join(f"{a:g} deg: {k / 1e3:.2f} kN/m" for a, k in zip(angles, point))
+                  + f"; mean {np.mean(point) / 1e3:.2f} kN/m")
+    for key, k in nominal.items():
+        console.print(f"plate secant stiffness at the nominal {geometry.nominal_load:g} N, wheel at {key} deg: {k / 1e3:.2f} kN/m")
+    console.print(f"wrote {out / 'load_test.csv'}, {out / 'load_test.png'}, {out / 'summary.json'}")
+    return EXIT_OK
+
+
+def _progress(console):
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    return Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                    TimeRemainingColumn(), console=console, transient=True)
+
+
+def _plot_load_curves(curves, geometry, path):
+    import matplotlib
+    import numpy as np
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wheelsoil.provenance import atomic_output
+
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    for c in curves:
+        ax.plot(1e3 * np.concatenate([[0], c.deflection]), np.concatenate([[0], c.force]), "o-",
+                label=f"wheel turned {c.angle:g} deg")
+    if geometry.nominal_load:
+        ax.axhline(geometry.nominal_load, color="0.5", ls="--", lw=0.8, label=f"nominal {geometry.nominal_load:g} N")
+    ax.set_xlabel("plate deflection [mm]")
+    ax.set_ylabel("plate force [N]")
+    ax.set_title(f"{geometry.name}: radial load against a flat plate")
+    ax.legend()
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
+    plt.close(fig)
 
 
 def _console():

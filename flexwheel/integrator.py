@@ -42,12 +42,21 @@ def node_update(
     n: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: ti.template(), v: ti.template(), rot: ti.template(),
     w: ti.template(), mass: ti.template(), inertia: ti.template(), free: ti.template(), f_ext: ti.template(),
     m_ext: ti.template(), slot_start: ti.template(), slot_list: ti.template(), slot_f: ti.template(),
-    slot_m: ti.template(), f_tot: ti.template(), m_tot: ti.template(),
+    slot_m: ti.template(), f_tot: ti.template(), m_tot: ti.template(), plane: ti.template(), plane_k: ti.f64,
+    contact: ti.template(),
 ):
-    """Gather node n's force and moment from its element slots; advance it if it is free."""
+    """Gather node n's force and moment from its element slots; advance it if it is free.
+
+    A rigid frictionless plane (point ``plane[0]``, unit normal ``plane[1]``) pushes contact nodes
+    that penetrate it with the penalty force k_p * penetration along the normal (``plane_k`` = 0: off).
+    """
     c1 = 1.0 - 0.5 * damping * dt
     c2 = 1.0 / (1.0 + 0.5 * damping * dt)
     f = f_ext[n] + mass[n] * gravity
+    if plane_k > 0.0 and contact[n]:
+        depth = (plane[0] - x[n]).dot(plane[1])
+        if depth > 0.0:
+            f += plane_k * depth * plane[1]
     m = m_ext[n]
     for k in range(slot_start[n], slot_start[n + 1]):
         s = slot_list[k]

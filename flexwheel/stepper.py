@@ -26,11 +26,12 @@ nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
 def nodes_parallel(
     n_nodes: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(),
     w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32, f_ext: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32,
-    slot_list: nd_i32, slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3,
+    slot_list: nd_i32, slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3, plane: nd_vec3,
+    plane_k: ti.f64, contact: nd_i32,
 ):
     for n in range(n_nodes):
         itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, m_ext, slot_start,
-                        slot_list, slot_f, slot_m, f_tot, m_tot)
+                        slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact)
 
 
 @ti.kernel
@@ -55,7 +56,7 @@ def steps_serial(
     kb: ti.types.ndarray(),
     ends: ti.types.ndarray(), bframe0: ti.types.ndarray(), blen0: nd_f64, rigidity: ti.types.ndarray(),
     hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: ti.types.ndarray(), hub_scalar: nd_f64,
-    peak: nd_f64,
+    peak: nd_f64, plane: nd_vec3, plane_k: ti.f64, contact: nd_i32,
 ):
     """``n_steps`` complete steps in one launch; counts = (nodes, facets, beams, hub nodes)."""
     ti.loop_config(serialize=True)
@@ -66,7 +67,7 @@ def steps_serial(
             beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * counts[1], 1)
         for n in range(counts[0]):
             itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, m_ext, slot_start,
-                            slot_list, slot_f, slot_m, f_tot, m_tot)
+                            slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact)
         if counts[3] > 0:
             itg.hub_update(dt, gravity, counts[3], hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
             for k in range(counts[3]):

@@ -96,7 +96,7 @@ class Structure:
         ``SERIAL_ELEMENT_LIMIT`` elements, where parallel-loop dispatch costs more than the work).
     """
 
-    SERIAL_ELEMENT_LIMIT = 2000
+    SERIAL_ELEMENT_LIMIT = 20_000
     MAX_STEPS_PER_LAUNCH = 20_000
 
     def __init__(
@@ -191,6 +191,9 @@ class Structure:
         d["f_tot"] = _vec(np.zeros((n, 3)))
         d["m_tot"] = _vec(np.zeros((n, 3)))
         d["peak"] = _nd(ti.f64, np.zeros(2))
+        d["plane"] = _vec(np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))
+        d["contact"] = _nd(ti.i32, np.zeros(n, np.int32))
+        self._plane_k = 0.0
         self._dev = d
 
         # ---- hub
@@ -276,6 +279,7 @@ class Structure:
                     d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
                     d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
                     d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"], d["hub_scalar"], d["peak"],
+                    d["plane"], self._plane_k, d["contact"],
                 )
         else:
             for _ in range(n_steps):
@@ -288,7 +292,7 @@ class Structure:
                 stepper.nodes_parallel(
                     self.mesh.n_nodes, dt, self.damping, g, d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
                     d["free"], d["f_ext"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
-                    d["f_tot"], d["m_tot"])
+                    d["f_tot"], d["m_tot"], d["plane"], self._plane_k, d["contact"])
                 if n_hub:
                     stepper.hub_parallel(n_hub, dt, g, d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"],
                                          d["hub_scalar"], d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
@@ -328,6 +332,30 @@ class Structure:
                 f"{math.sqrt(worst) if worst < 1e300 else float('nan'):.3g} m/s (limit {limit:.3g} m/s, NaN means "
                 "non-finite state). Reduce the time step (safety) or the loads."
             )
+
+    # ------------------------------------------------------------------ rigid plane
+    def set_plane(self, point, normal, stiffness: float, nodes=None) -> None:
+        """A rigid frictionless plane that pushes ``nodes`` (default: the surface facets' nodes) back
+        with the penalty force ``stiffness`` [N/m] x penetration along ``normal``. ``stiffness=0`` removes it.
+        """
+        normal = np.asarray(normal, float).reshape(3)
+        if not (np.isfinite(stiffness) and stiffness >= 0) or np.linalg.norm(normal) == 0:
+            raise WheelsoilInputError(f"plane stiffness={stiffness!r} must be >= 0 and the normal non-zero")
+        nodes = np.unique(self.surface_triangles) if nodes is None else np.asarray(nodes, np.int64)
+        mask = np.zeros(self.mesh.n_nodes, np.int32)
+        mask[nodes] = 1
+        self._dev["contact"].from_numpy(mask)
+        self._dev["plane"].from_numpy(np.array([np.asarray(point, float).reshape(3), normal / np.linalg.norm(normal)]))
+        self._plane_k = float(stiffness)
+
+    def plane_force(self) -> np.ndarray:
+        """Force [N] the rigid plane exerts on the structure in the current state."""
+        if self._plane_k == 0.0:
+            return np.zeros(3)
+        point, normal = self._dev["plane"].to_numpy()
+        mask = self._dev["contact"].to_numpy().astype(bool)
+        depth = np.clip((point - self.positions()[mask]) @ normal, 0.0, None)
+        return self._plane_k * depth.sum() * normal
 
     # ------------------------------------------------------------------ hub
     def _hub_state(self) -> np.ndarray:

@@ -1,0 +1,289 @@
+"""Parametric flexible metal wheel: geometry, presets and the structured shell/beam mesh.
+
+The wheel (axle along y, wheel plane x-z, centre at the origin) is made of
+* a cylindrical **tread** shell (outer radius ``radius``, mid-surface at radius - thickness/2);
+* optional **grousers**: radial plates across the full width on the tread's outside;
+* **spokes**: bowed flexures from the hub radius to the tread, in one or more rows across the width
+  (each row spans a band of the width and has its own angular offset, so the ExoMars-like layout of
+  three loops per side plus three inner loops rotated by 60 deg is a preset); modelled as shells or
+  as beams;
+* a rigid **hub**: the spokes' inner nodes are tied to it (see :class:`~.structure.Structure`).
+
+The contact surface is the tread and grousers. Element size is the resolution parameter; the angular
+and width grids are refined until every grouser, spoke and row boundary falls on a grid line.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+
+from .beam import rectangular_section
+from .material import SEED004_WHEEL, SPRING_STEEL, ElasticMaterial
+from .mesh import StructureMesh
+from .shapes import grid_triangles
+
+PARTS = ["tread", "grouser", "spoke"]
+
+
+@dataclass(frozen=True)
+class SpokeRow:
+    """A row of spokes: the band [y_min, y_max] of the width (fractions of the width, -0.5..0.5) and
+    the angle [deg] of its first spoke; the row's spokes are spread evenly around the wheel."""
+
+    y_min: float = -0.5
+    y_max: float = 0.5
+    angle: float = 0.0
+
+
+@dataclass(frozen=True)
+class WheelGeometry:
+    """Every dimension of a wheel [m, deg]; see the module docstring for the parts."""
+
+    radius: float
+    width: float
+    tread_thickness: float
+    hub_radius: float
+    spokes_per_row: int
+    spoke_thickness: float
+    spoke_rows: tuple[SpokeRow, ...] = (SpokeRow(),)
+    spoke_bow: float = 0.15
+    spoke_model: str = "shell"
+    grouser_count: int = 0
+    grouser_height: float = 0.0
+    grouser_thickness: float = 0.0
+    grouser_angle: float = 0.0
+    material: ElasticMaterial = field(default_factory=lambda: SEED004_WHEEL)
+    element_size: float = 0.02
+    hub_mass: float = 0.0
+    nominal_load: float = 0.0
+    name: str = "wheel"
+
+    def __post_init__(self) -> None:
+        def positive(key):
+            v = getattr(self, key)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise WheelsoilInputError(f"wheel {self.name!r}: {key}={v!r} must be a finite number > 0")
+
+        for key in ("radius", "width", "tread_thickness", "hub_radius", "spoke_thickness", "element_size"):
+            positive(key)
+        if self.hub_radius >= self.radius - self.tread_thickness:
+            raise WheelsoilInputError(
+                f"wheel {self.name!r}: hub_radius={self.hub_radius!r} m must be smaller than the tread's inner "
+                f"radius {self.radius - self.tread_thickness:.4g} m"
+            )
+        if self.tread_thickness >= 0.25 * self.radius:
+            raise WheelsoilInputError(
+                f"wheel {self.name!r}: tread_thickness={self.tread_thickness!r} m is not thin (must be < radius/4)"
+            )
+        if int(self.spokes_per_row) != self.spokes_per_row or self.spokes_per_row < 1:
+            raise WheelsoilInputError(f"wheel {self.name!r}: spokes_per_row={self.spokes_per_row!r} must be an integer >= 1")
+        if not (0.0 <= self.spoke_bow <= 0.5):
+            raise WheelsoilInputError(f"wheel {self.name!r}: spoke_bow={self.spoke_bow!r} must lie in [0, 0.5]")
+        if self.spoke_model not in ("shell", "beam"):
+            raise WheelsoilInputError(f"wheel {self.name!r}: spoke_model={self.spoke_model!r}; choose 'shell' or 'beam'")
+        if not self.spoke_rows:
+            raise WheelsoilInputError(f"wheel {self.name!r}: spoke_rows is empty; the tread must be held by spokes")
+        for k, row in enumerate(self.spoke_rows):
+            if not (-0.5 <= row.y_min < row.y_max <= 0.5):
+                raise WheelsoilInputError(
+                    f"wheel {self.name!r}: spoke_rows[{k}] spans y in [{row.y_min}, {row.y_max}] (fractions of the "
+                    "width); need -0.5 <= y_min < y_max <= 0.5"
+                )
+        if int(self.grouser_count) != self.grouser_count or self.grouser_count < 0:
+            raise WheelsoilInputError(f"wheel {self.name!r}: grouser_count={self.grouser_count!r} must be an integer >= 0")
+        if self.grouser_count:
+            positive("grouser_height")
+            positive("grouser_thickness")
+        if self.element_size > 0.25 * self.width:
+            raise WheelsoilInputError(
+                f"wheel {self.name!r}: element_size={self.element_size!r} m is too coarse for width {self.width} m "
+                f"(must be <= {0.25 * self.width:.4g} m)"
+            )
+
+    @property
+    def spoke_pitch(self) -> float:
+        """Angle [deg] after which the spoke layout repeats (60 deg for six virtual spokes)."""
+        angles = sorted({round((row.angle + 360.0 * k / self.spokes_per_row) % 360.0, 9)
+                         for row in self.spoke_rows for k in range(self.spokes_per_row)})
+        return 360.0 / len(angles)
+
+    def with_element_size(self, size: float) -> "WheelGeometry":
+        return replace(self, element_size=float(size))
+
+    @property
+    def tread_mid_radius(self) -> float:
+        return self.radius - 0.5 * self.tread_thickness
+
+
+def _grid_count(fractions: list[float], start: int, period: float = 1.0) -> int:
+    """Smallest n >= start for which every fraction (of ``period``) is a multiple of period / n."""
+    for n in range(max(start, 1), 100_000):
+        if all(abs(f * n / period - round(f * n / period)) < 1e-6 for f in fractions):
+            return n
+    raise WheelsoilInputError(f"no grid of up to 100000 divisions puts nodes at {fractions}")
+
+
+def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray]:
+    """Mesh the wheel. Returns the mesh and the indices of the hub nodes (spokes' inner ends)."""
+    g = geometry
+    h = g.element_size
+    r_mid = g.tread_mid_radius
+    # ---- angular grid: tread nodes at every grouser and spoke angle
+    turns = []
+    for row in g.spoke_rows:
+        turns += [((row.angle / 360.0) + k / g.spokes_per_row) % 1.0 for k in range(g.spokes_per_row)]
+    turns += [((g.grouser_angle / 360.0) + k / g.grouser_count) % 1.0 for k in range(g.grouser_count)]
+    n_around = _grid_count(turns, math.ceil(2 * math.pi * r_mid / h))
+    # ---- width grid: nodes at every row boundary
+    bounds = [row.y_min + 0.5 for row in g.spoke_rows] + [row.y_max + 0.5 for row in g.spoke_rows]
+    n_width = _grid_count(bounds, max(2, math.ceil(g.width / h)))
+    nw1 = n_width + 1
+    phi = 2 * math.pi * np.arange(n_around) / n_around
+    y = np.linspace(-g.width / 2, g.width / 2, nw1)
+    pp, yy = np.meshgrid(phi, y, indexing="ij")
+    nodes = [np.c_[r_mid * np.cos(pp.ravel()), yy.ravel(), r_mid * np.sin(pp.ravel())]]
+    n_nodes = n_around * nw1
+    tri = [grid_triangles(n_around, n_width, periodic_u=True)[:, ::-1]]  # outward normals
+    thick = [np.full(len(tri[0]), g.tread_thickness)]
+    part = [np.zeros(len(tri[0]), np.int64)]
+
+    def tread_node(i, j):
+        return (i % n_around) * nw1 + j
+
+    # ---- grousers: radial plates outside the tread
+    if g.grouser_count:
+        n_g = max(1, math.ceil(g.grouser_height / h))
+        for k in range(g.grouser_count):
+            i = int(round(((g.grouser_angle / 360.0 + k / g.grouser_count) % 1.0) * n_around)) % n_around
+            c, s = math.cos(phi[i]), math.sin(phi[i])
+            # grouser runs from the tread mid-surface to the outer radius + grouser height
+            heights = np.linspace(0.0, g.grouser_height + 0.5 * g.tread_thickness, n_g + 1)[1:]
+            rr = r_mid + heights
+            rr_g, yy_g = np.meshgrid(rr, y, indexing="ij")
+            new = np.c_[rr_g.ravel() * c, yy_g.ravel(), rr_g.ravel() * s]
+            ids = np.vstack([[tread_node(i, j) for j in range(nw1)], n_nodes + np.arange(n_g * nw1).reshape(n_g, nw1)])
+            nodes.append(new)
+            n_nodes += len(new)
+            local = grid_triangles(n_g, n_width)
+            tri.append(ids.ravel()[local])
+            thick.append(np.full(len(local), g.grouser_thickness))
+            part.append(np.ones(len(local), np.int64))
+    # ---- spokes
+    hub_nodes = []
+    beams, beam_sec = [], []
+    span = r_mid - g.hub_radius
+    n_s = max(2, math.ceil(span * (1 + 2 * g.spoke_bow) / h))
+    u = np.linspace(0.0, 1.0, n_s + 1)
+    for row in g.spoke_rows:
+        j0 = int(round((row.y_min + 0.5) * n_width))
+        j1 = int(round((row.y_max + 0.5) * n_width))
+        cols = np.arange(j0, j1 + 1)
+        for k in range(g.spokes_per_row):
+            i = int(round(((row.angle / 360.0 + k / g.spokes_per_row) % 1.0) * n_around)) % n_around
+            c, s = math.cos(phi[i]), math.sin(phi[i])
+            radial = np.array([c, s])
+            tangent = np.array([-s, c])
+            path = (g.hub_radius + u[:, None] * span) * radial + (g.spoke_bow * span * np.sin(np.pi * u))[:, None] * tangent
+            inner = path[:-1]  # the last point is the tread node
+            new = np.zeros((len(inner), len(cols), 3))
+            new[..., 0] = inner[:, None, 0]
+            new[..., 2] = inner[:, None, 1]
+            new[..., 1] = y[cols][None, :]
+            ids = np.vstack([n_nodes + np.arange(new.shape[0] * new.shape[1]).reshape(new.shape[:2]),
+                             [[tread_node(i, j) for j in cols]]])
+            nodes.append(new.reshape(-1, 3))
+            n_nodes += new.shape[0] * new.shape[1]
+            hub_nodes.extend(ids[0].tolist())
+            if g.spoke_model == "shell":
+                local = grid_triangles(n_s, len(cols) - 1)
+                tri.append(ids.ravel()[local])
+                thick.append(np.full(len(local), g.spoke_thickness))
+                part.append(np.full(len(local), 2, np.int64))
+            else:
+                strip_width = (row.y_max - row.y_min) * g.width / len(cols)
+                for jc in range(len(cols)):
+                    for a in range(n_s):
+                        beams.append((ids[a, jc], ids[a + 1, jc]))
+                        beam_sec.append(rectangular_section(strip_width, g.spoke_thickness))
+    triangles = np.vstack(tri)
+    n_tri = len(triangles)
+    surface = np.flatnonzero(np.concatenate(part) <= 1)
+    beam_arr = np.asarray(beams, np.int64).reshape(-1, 2)
+    mesh = StructureMesh(
+        nodes=np.vstack(nodes),
+        triangles=triangles,
+        thickness=np.concatenate(thick),
+        material=g.material,
+        beams=beam_arr,
+        beam_section=np.asarray(beam_sec).reshape(-1, 4) if beams else None,
+        beam_orientation=[0.0, 1.0, 0.0] if beams else None,
+        part=np.concatenate(part + [np.full(len(beam_arr), 2, np.int64)]),
+        part_names=list(PARTS),
+        surface=surface,
+    )
+    assert n_tri == len(mesh.triangles)
+    return mesh, np.unique(np.asarray(hub_nodes, np.int64))
+
+
+#: The flexible metal wheel of the staffed lunar rover of seed 004 (r = 0.6 m, b = 0.5 m, Table 2
+#: material E = 800 MPa, nu = 0.288, rho = 7850 kg/m^3). The paper gives no drawing dimensions; the
+#: tread, spoke and grouser sizes are ours (two side rows of 12 bowed spokes). ``element_size``
+#: 0.018 m gives a mesh of the paper's size (about 30,000 elements); coarser sizes are for quick runs.
+LUNAR_ROVER = WheelGeometry(
+    name="lunar-rover",
+    radius=0.6,
+    width=0.5,
+    tread_thickness=0.005,
+    hub_radius=0.15,
+    spokes_per_row=12,
+    spoke_thickness=0.010,
+    spoke_rows=(SpokeRow(-0.5, -0.3, 0.0), SpokeRow(0.3, 0.5, 0.0)),
+    spoke_bow=0.1,
+    grouser_count=24,
+    grouser_height=0.02,
+    grouser_thickness=0.004,
+    grouser_angle=7.5,
+    material=SEED004_WHEEL,
+    element_size=0.018,
+    hub_mass=20.0,
+    nominal_load=3000.0,
+)
+
+#: ExoMars-like flexible wheel (seed 000: r = 142.5 mm, b = 120 mm, 12 grousers of 12.5 mm; three
+#: flexible loops on each side plus three inner loops rotated by 60 deg = six virtual spokes, hence six
+#: stiffness peaks per turn). Sheet thicknesses are ours, chosen so that the radial point-load
+#: stiffness comes out near the 13.2 kN/m quoted for the ExoMars wheel in seed 001.
+EXOMARS = WheelGeometry(
+    name="exomars",
+    radius=0.1425,
+    width=0.12,
+    tread_thickness=0.0008,
+    hub_radius=0.045,
+    spokes_per_row=3,
+    spoke_thickness=0.0005,
+    spoke_rows=(SpokeRow(-0.5, -0.25, 0.0), SpokeRow(0.25, 0.5, 0.0), SpokeRow(-0.125, 0.125, 60.0)),
+    spoke_bow=0.3,
+    grouser_count=12,
+    grouser_height=0.0125,
+    grouser_thickness=0.0010,
+    grouser_angle=15.0,
+    material=SPRING_STEEL,
+    element_size=0.006,
+    hub_mass=1.0,
+    nominal_load=172.0,
+)
+
+PRESETS = {g.name: g for g in (LUNAR_ROVER, EXOMARS)}
+
+
+def preset(name: str) -> WheelGeometry:
+    """A preset wheel by name (``lunar-rover`` or ``exomars``)."""
+    try:
+        return PRESETS[name]
+    except KeyError:
+        raise WheelsoilInputError(f"unknown wheel preset {name!r}; choose one of {sorted(PRESETS)}") from None
