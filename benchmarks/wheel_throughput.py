@@ -1,0 +1,85 @@
+"""Wheel FEM speed: element updates per second and the cost of one DEM-step interval.
+
+Meshes the seed-004 lunar-rover preset at its default resolution (about the paper's 29,644 elements)
+and a coarse copy, times steady stepping in the serial (one launch per batch of steps) and parallel
+(one launch per phase) forms, and reports the wheel's stable time step next to the soil's (seed-004
+particles of 16-24 mm, seed-004 Table 1 soil, steel wall pairs), i.e. how many wheel sub-steps one
+DEM step costs, and what that interval takes on this machine.
+
+Run:  python -m wheelsoil.benchmarks.wheel_throughput [--out benchmarks/results/wheel.json]
+"""
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+from wheelsoil import runtime
+from wheelsoil.benchmarks.common import machine, peak_rss_mib, versions
+
+
+def _time_steps(structure, n_steps: int, repeats: int = 3) -> float:
+    structure.step(10)  # compile and warm up
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        structure.step(n_steps)
+        best = min(best, (time.perf_counter() - t0) / n_steps)
+    return best
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/wheel.json"))
+    parser.add_argument("--steps", type=int, default=200, help="steps per timing (default 200)")
+    parser.add_argument("--arch", default=None, help="Taichi backend (default cpu)")
+    args = parser.parse_args(argv)
+    runtime.init(args.arch)
+
+    from wheelsoil.flexwheel.geometry import LUNAR_ROVER, build_wheel_mesh
+    from wheelsoil.flexwheel.structure import Structure
+    from wheelsoil.granular.materials import LUNAR_SOIL_SIMULANT, STEEL, effective_modulus
+    from wheelsoil.granular.timestep import estimate_time_step
+
+    soil_dt = estimate_time_step(
+        0.008, LUNAR_SOIL_SIMULANT, wall_moduli=(effective_modulus(LUNAR_SOIL_SIMULANT, STEEL),), impact_speed=1.0
+    ).stable
+    results = {"machine": machine(), "versions": versions(), "soil_time_step_s": soil_dt, "cases": []}
+    for label, size in (("seed-004 size", LUNAR_ROVER.element_size), ("coarse", 0.05)):
+        t0 = time.perf_counter()
+        mesh, hub = build_wheel_mesh(LUNAR_ROVER.with_element_size(size))
+        t_mesh = time.perf_counter() - t0
+        for serial in (True, False):
+            t0 = time.perf_counter()
+            wheel = Structure(mesh, hub_nodes=hub, serial=serial)
+            t_setup = time.perf_counter() - t0
+            per_step = _time_steps(wheel, args.steps)
+            substeps = math.ceil(soil_dt / wheel.stable_time_step)
+            case = {
+                "mesh": label,
+                "elements": mesh.n_elements,
+                "nodes": mesh.n_nodes,
+                "form": "serial" if serial else "parallel",
+                "mesh_seconds": t_mesh,
+                "setup_seconds": t_setup,
+                "wheel_stable_time_step_s": wheel.stable_time_step,
+                "seconds_per_step": per_step,
+                "element_updates_per_second": mesh.n_elements / per_step,
+                "substeps_per_dem_step": substeps,
+                "seconds_per_dem_step_interval": substeps * per_step,
+            }
+            results["cases"].append(case)
+            print(f"{label:14s} {case['form']:8s} {mesh.n_elements:6d} elements: {1e3 * per_step:7.3f} ms/step, "
+                  f"{case['element_updates_per_second'] / 1e6:6.2f} M element updates/s, wheel dt "
+                  f"{wheel.stable_time_step:.3e} s vs soil dt {soil_dt:.3e} s -> {substeps} sub-steps, "
+                  f"{1e3 * case['seconds_per_dem_step_interval']:.2f} ms per DEM step")
+    results["peak_rss_mib"] = peak_rss_mib()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(results, indent=2))
+    print(f"peak RSS {results['peak_rss_mib']:.0f} MiB; wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
