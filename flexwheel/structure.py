@@ -315,8 +315,6 @@ class Structure:
             self.set_external(forces, moments)
         n_sub = 1 if not math.isfinite(self.stable_time_step) else max(1, math.ceil(interval / self.stable_time_step * (1 - 1e-12)))
         dt = interval / n_sub
-        if not math.isfinite(self.critical_time_step):
-            self.critical_time_step = dt  # rigid: any step is stable
         self.step(n_sub, dt)
         if check:
             self.check_health()
