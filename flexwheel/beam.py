@@ -17,15 +17,9 @@ Same EICR recipe as the shell (see ``shell.py``), after Crisfield (1990), CMAME 
 import numpy as np
 import taichi as ti
 
-from .rotation import exp_so3, log_so3, mat3, spin_jacobian_inverse, vec3
+from wheelsoil.taichi_types import nd_f64, nd_ivec2, nd_mat3, nd_vec3, nd_vec4, vec3
 
-vec4 = ti.types.vector(4, ti.f64)
-ivec2 = ti.types.vector(2, ti.i32)
-nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
-nd_vec4 = ti.types.ndarray(dtype=vec4, ndim=1)
-nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
-nd_ivec2 = ti.types.ndarray(dtype=ivec2, ndim=1)
-nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
+from .rotation import exp_so3, log_so3, spin_jacobian_inverse
 
 
 def rectangular_section(width: float, height: float) -> tuple[float, float, float, float]:

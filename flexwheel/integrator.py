@@ -18,12 +18,9 @@ axis aligned with a global axis (a wheel's axle), an approximation otherwise.
 
 import taichi as ti
 
-from .rotation import exp_so3, mat3, vec3
+from wheelsoil.taichi_types import nd_f64, nd_i32, nd_vec3, vec3
 
-nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
-nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
-nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
-nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
+from .rotation import exp_so3
 
 # rows of the hub state array (vec3 each)
 HUB_POSITION, HUB_VELOCITY, HUB_SPIN = 0, 1, 2

@@ -9,8 +9,7 @@ variation dR = spin(d omega) R, d theta = H(theta) d omega with
 
 import taichi as ti
 
-vec3 = ti.types.vector(3, ti.f64)
-mat3 = ti.types.matrix(3, 3, ti.f64)
+from wheelsoil.taichi_types import mat3, vec3
 
 
 @ti.func

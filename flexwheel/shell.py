@@ -23,20 +23,10 @@ Felippa & Haugen (2005), CMAME 194, 2285-2335:
 import numpy as np
 import taichi as ti
 
-from .rotation import log_so3, mat3, spin_jacobian_inverse, vec3
+from wheelsoil.taichi_types import mat3, nd_f64, nd_ivec3, nd_mat3, nd_mat9, nd_mat32, nd_vec3, vec3, vec9
+
+from .rotation import log_so3, spin_jacobian_inverse
 from .shell_stiffness import bending_stiffness, membrane_stiffness
-
-mat9 = ti.types.matrix(9, 9, ti.f64)
-mat32 = ti.types.matrix(3, 2, ti.f64)
-vec9 = ti.types.vector(9, ti.f64)
-ivec3 = ti.types.vector(3, ti.i32)
-
-nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
-nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
-nd_mat9 = ti.types.ndarray(dtype=mat9, ndim=1)
-nd_mat32 = ti.types.ndarray(dtype=mat32, ndim=1)
-nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
-nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 
 
 def facet_frames(x: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -42,9 +42,7 @@ def residuals(structure: Structure) -> tuple[float, float]:
     free[structure.hub_nodes] = False
     f_ext = structure._dev["f_ext"].to_numpy() + structure.mass[:, None] * structure.gravity
     m_ext = structure._dev["m_ext"].to_numpy()
-    structure.internal_forces()
-    slot_f = structure._dev["slot_f"].to_numpy()
-    slot_m = structure._dev["slot_m"].to_numpy()
+    slot_f, slot_m = structure.element_corner_forces()
     size = structure.mesh.characteristic_length()
     scale_f = max(np.linalg.norm(f_ext[free]), 0.5 * np.linalg.norm(slot_f), 1e-300)
     scale_m = max(np.linalg.norm(m_ext[free]), 0.5 * np.linalg.norm(slot_m), scale_f * size)

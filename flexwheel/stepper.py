@@ -14,12 +14,9 @@ import taichi as ti
 
 from . import integrator as itg
 from .beam import beam_element
-from .rotation import vec3
-from .shell import shell_element
+from wheelsoil.taichi_types import nd_f64, nd_i32, nd_vec3, vec3
 
-nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
-nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
-nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
+from .shell import shell_element
 
 
 @ti.kernel

@@ -17,13 +17,13 @@ import taichi as ti
 
 from wheelsoil import runtime
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
+from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat9, mat32, vec3, vec4
 
 from . import integrator as itg
 from . import stepper
 from .beam import beam_energies, beam_forces, beam_frames, beam_section_stiffness
 from .mesh import StructureMesh
-from .rotation import mat3, vec3
-from .shell import mat9, mat32, shell_energies, shell_forces, shell_setup
+from .shell import shell_energies, shell_forces, shell_setup
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
@@ -147,28 +147,28 @@ class Structure:
         d = {}
         if self.n_facets:
             frames, local, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
-            d["tri"] = _nd(ti.types.vector(3, ti.i32), mesh.triangles.astype(np.int32))
+            d["tri"] = _nd(ivec3, mesh.triangles.astype(np.int32))
             d["frame0"] = _nd(mat3, frames)
             d["local0"] = _nd(mat32, local)
             d["km"] = _nd(mat9, km)
             d["kb"] = _nd(mat9, kb)
         else:
-            d["tri"] = _nd(ti.types.vector(3, ti.i32), np.zeros((1, 3), np.int32))
+            d["tri"] = _nd(ivec3, np.zeros((1, 3), np.int32))
             d["frame0"] = _nd(mat3, np.eye(3)[None])
             d["local0"] = _nd(mat32, np.zeros((1, 3, 2)))
             d["km"] = _nd(mat9, np.zeros((1, 9, 9)))
             d["kb"] = _nd(mat9, np.zeros((1, 9, 9)))
         if self.n_beams:
             bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
-            d["ends"] = _nd(ti.types.vector(2, ti.i32), mesh.beams.astype(np.int32))
+            d["ends"] = _nd(ivec2, mesh.beams.astype(np.int32))
             d["bframe0"] = _nd(mat3, bframes)
             d["blen0"] = _nd(ti.f64, blen)
-            d["rigidity"] = _nd(ti.types.vector(4, ti.f64), beam_section_stiffness(mesh.beam_section, mesh.material))
+            d["rigidity"] = _nd(vec4, beam_section_stiffness(mesh.beam_section, mesh.material))
         else:
-            d["ends"] = _nd(ti.types.vector(2, ti.i32), np.array([[0, 0]], np.int32))
+            d["ends"] = _nd(ivec2, np.array([[0, 0]], np.int32))
             d["bframe0"] = _nd(mat3, np.eye(3)[None])
             d["blen0"] = _nd(ti.f64, np.ones(1))
-            d["rigidity"] = _nd(ti.types.vector(4, ti.f64), np.zeros((1, 4)))
+            d["rigidity"] = _nd(vec4, np.zeros((1, 4)))
         slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
         order = np.argsort(slot_node, kind="stable")
         start = np.zeros(n + 1, np.int32)
@@ -283,12 +283,7 @@ class Structure:
                 )
         else:
             for _ in range(n_steps):
-                if n_facets:
-                    shell_forces(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
-                                 d["slot_f"], d["slot_m"], 0)
-                if n_beams:
-                    beam_forces(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
-                                d["slot_f"], d["slot_m"], self._slot_beam_base)
+                self._launch_element_forces()
                 stepper.nodes_parallel(
                     self.mesh.n_nodes, dt, self.damping, g, d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
                     d["free"], d["f_ext"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
@@ -463,18 +458,29 @@ class Structure:
                     raise WheelsoilInputError(f"{key} must be a finite array of shape {(self.mesh.n_nodes,) + shape}")
                 self._dev[key].from_numpy(arr)
 
-    def internal_forces(self) -> tuple[np.ndarray, np.ndarray]:
-        """Elastic nodal forces and moments (N, 3) of the current state (no step is taken)."""
-        d = self._dev
-        n = self.mesh.n_nodes
+    def _launch_element_forces(self) -> None:
+        """Evaluate every element's corner forces and moments into the slot arrays (parallel kernels)."""
         if self.rigid:
-            return np.zeros((n, 3)), np.zeros((n, 3))
+            return
+        d = self._dev
         if self.n_facets:
             shell_forces(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"], d["slot_f"], d["slot_m"], 0)
         if self.n_beams:
             beam_forces(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"], d["slot_f"],
                         d["slot_m"], self._slot_beam_base)
-        sf, sm = d["slot_f"].to_numpy(), d["slot_m"].to_numpy()
+
+    def element_corner_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Elastic force and moment on each element corner of the current state (facet corners, then
+        beam ends; zero for a rigid structure). No step is taken."""
+        self._launch_element_forces()
+        return self._dev["slot_f"].to_numpy(), self._dev["slot_m"].to_numpy()
+
+    def internal_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Elastic nodal forces and moments (N, 3) of the current state (no step is taken)."""
+        n = self.mesh.n_nodes
+        if self.rigid:
+            return np.zeros((n, 3)), np.zeros((n, 3))
+        sf, sm = self.element_corner_forces()
         nodes = np.concatenate([self.mesh.triangles.reshape(-1), self.mesh.beams.reshape(-1)])
         f, m = np.zeros((n, 3)), np.zeros((n, 3))
         np.add.at(f, nodes, sf[: len(nodes)])

@@ -13,16 +13,17 @@ tells each particle which pairs it takes part in, in row order.
 
 import taichi as ti
 
-vec3 = ti.types.vector(3, ti.f64)
-ivec3 = ti.types.vector(3, ti.i32)
-
-nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
-nd_vec3_2d = ti.types.ndarray(dtype=vec3, ndim=2)
-nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
-nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
-nd_i32_2d = ti.types.ndarray(dtype=ti.i32, ndim=2)
-mat3 = ti.types.matrix(3, 3, ti.f64)
-nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
+from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, integrator.py, scene.py)
+    ivec3,
+    mat3,
+    nd_f64,
+    nd_i32,
+    nd_i32_2d,
+    nd_mat3,
+    nd_vec3,
+    nd_vec3_2d,
+    vec3,
+)
 
 
 @ti.func
