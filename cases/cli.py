@@ -26,7 +26,11 @@ rendered to PNG):
 
     wheelsoil run
 
-then prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
+drive the lunar-rover wheel through a bed (about two minutes on two cores):
+
+    wheelsoil testbed smoke-1g-steer
+
+or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
     wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --gravity moon --out moon_bed.h5
     wheelsoil render moon_bed.h5 --out moon_bed.png
@@ -128,7 +132,97 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-load-factor", type=float, default=1.5,
                    help="largest plate load as a multiple of the preset's nominal load (default 1.5)")
     p.set_defaults(func=cmd_wheel)
+
+    p = sub.add_parser("testbed", help="drive a wheel through a prepared bed (single-wheel testbed)",
+                       description="Run a testbed case: prepare (or reuse) its bed under the case's gravity, lower "
+                                   "the wheel until the soil carries the load W, drive at the commanded slip and "
+                                   "steering angle, detect the steady state and average. Writes series.csv, "
+                                   "summary.json and series.png to --out. Cases: smoke-1g-steer (about 2 minutes "
+                                   "on 2 cores, W = 3000 N), smoke-moon-steer (1/6 g, W = 500 N), seed004-1g-steer "
+                                   "and seed004-moon-steer (full scale, hours).")
+    p.add_argument("case", help="case name (smoke-1g-steer, smoke-moon-steer, seed004-1g-steer, seed004-moon-steer)")
+    p.add_argument("--slip", type=float, default=None, help="longitudinal slip i in [-1, 1) (default: the case's)")
+    p.add_argument("--slip-angle", type=float, default=None, help="steering angle beta [deg] in (-90, 90)")
+    p.add_argument("--load", type=float, default=None, help="vertical load W [N] > 0, wheel weight included")
+    p.add_argument("--drive-time", type=float, default=None, help="driving time [s]")
+    p.add_argument("--rigid", action="store_true", help="use the rigid wheel with the same surface")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case>)")
+    p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
+    p.set_defaults(func=cmd_testbed)
     return parser
+
+
+def cmd_testbed(args) -> int:
+    import json
+
+    from wheelsoil.coupling.presets import preset_case
+    from wheelsoil.coupling.testbed import SERIES_UNITS, Testbed
+    from wheelsoil.granular import prepare_bed
+    from wheelsoil.provenance import atomic_output, provenance
+
+    console = _console()
+    overrides = {k: v for k, v in (("slip", args.slip), ("slip_angle", args.slip_angle), ("load", args.load),
+                                   ("drive_time", args.drive_time)) if v is not None}
+    if args.rigid:
+        overrides["rigid"] = True
+    case = preset_case(args.case, **overrides)
+    out = args.out or Path("wheelsoil-output") / case.name
+    bed = prepare_bed(case.bed, progress=console.is_terminal, arch=args.arch)
+    console.print(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
+    bench = Testbed(bed, case.wheel, case.testbed, arch=args.arch)
+    console.print(f"wheel {case.wheel.name}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
+                  f"{'rigid' if case.testbed.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; "
+                  f"slip {case.testbed.slip:g}, steering {case.testbed.slip_angle:g} deg, W = {case.testbed.load:g} N")
+    result = bench.run(progress=console.is_terminal)
+    names = list(SERIES_UNITS)
+    rows = [",".join(f"{n}[{SERIES_UNITS[n]}]" for n in names)]
+    rows += [",".join(f"{result.series[n][k]:.9g}" for n in names) for k in range(len(result.series["t"]))]
+    with atomic_output(out / "series.csv") as tmp:
+        tmp.write_text("\n".join(rows) + "\n")
+    summary = {"case": case.name, "testbed": case.testbed.to_dict(), "bed": case.bed.to_dict(),
+               "wheel": case.wheel.name, "element_size_m": case.wheel.element_size, "summary": result.summary,
+               "run": result.info, "provenance": provenance()}
+    with atomic_output(out / "summary.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2, default=str))
+    _plot_series(result, out / "series.png", case.name)
+    s = result.summary
+    console.print(("steady state" if s["steady"] else "[yellow]no steady state detected; averaged the last half[/]")
+                  + f" over t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s:")
+    for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage"):
+        console.print(f"  {q:15s} {s[q]['mean']:10.4g} +- {s[q]['std']:.3g} {s[q]['units']}")
+    console.print(f"{result.info['wall_seconds']:.0f} s wall for {result.info['simulated_seconds']:.2f} s simulated; "
+                  f"wrote {out / 'series.csv'}, {out / 'summary.json'}, {out / 'series.png'}")
+    return EXIT_OK
+
+
+def _plot_series(result, path, title):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wheelsoil.provenance import atomic_output
+
+    s, t = result.series, result.series["t"]
+    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+    for name in ("drawbar_pull", "lateral_force", "vertical_force"):
+        axes[0].plot(t, s[name], label=name.replace("_", " "))
+    axes[0].axhline(result.spec.load, color="0.5", ls="--", lw=0.8, label="load W")
+    axes[0].set_ylabel("force on the wheel [N]")
+    axes[1].plot(t, s["torque"], color="C3")
+    axes[1].set_ylabel("driving torque [N m]")
+    axes[2].plot(t, 1e3 * s["sinkage"], color="C4")
+    axes[2].set_ylabel("sinkage [mm]")
+    axes[2].set_xlabel("time [s]")
+    t0, t1 = result.summary["window"]
+    for ax in axes:
+        ax.axvspan(t0, t1, color="0.9", zorder=0)
+    axes[0].legend(fontsize=8, ncol=2)
+    axes[0].set_title(f"{title} (shaded: averaging window)")
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
 
 
 def cmd_wheel(args) -> int:

@@ -2,7 +2,7 @@
 
 Translations: v^{n+1/2} = [(1 - a dt/2) v^{n-1/2} + dt f^n / m] / (1 + a dt/2), x^{n+1} = x^n + dt v^{n+1/2}
 (central difference with mass-proportional damping a [1/s], Belytschko, Liu & Moran, *Nonlinear Finite
-Elements*, sec. 6.2.4). Rotations: the same for the spin omega with the node's isotropic lumped rotary
+Elements*, sec. 6.2.4), with v taken relative to the hub's rigid-body motion when there is a hub. Rotations: the same for the spin omega with the node's isotropic lumped rotary
 inertia (no gyroscopic term for an isotropic inertia), then R^{n+1} = exp(dt omega^{n+1/2}) R^n.
 
 Every node's force is gathered from the element-corner slots that touch it (a CSR list), so no two
@@ -38,18 +38,27 @@ HUB_OWN_MASS, HUB_SAMPLES = 0, 1
 def node_update(
     n: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: ti.template(), v: ti.template(), rot: ti.template(),
     w: ti.template(), mass: ti.template(), inertia: ti.template(), free: ti.template(), f_ext: ti.template(),
-    m_ext: ti.template(), slot_start: ti.template(), slot_list: ti.template(), slot_f: ti.template(),
+    k_ext: ti.template(), x_anchor: ti.template(), m_ext: ti.template(), slot_start: ti.template(), slot_list: ti.template(), slot_f: ti.template(),
     slot_m: ti.template(), f_tot: ti.template(), m_tot: ti.template(), plane: ti.template(), plane_k: ti.f64,
-    contact: ti.template(),
+    contact: ti.template(), hub: ti.template(),
 ):
     """Gather node n's force and moment from its element slots; advance it if it is free.
+
+    The damping acts on the node's velocity and spin relative to the hub's rigid-body motion
+    (v - v_hub - omega_hub x (x - c_hub), omega - omega_hub), so a rolling wheel is not braked by it;
+    a structure without a hub has a hub state of zeros, and the damping acts on absolute velocities.
+
+    The external force is f_ext - k_ext (x - x_anchor): a coupling hands over its contact forces
+    evaluated with the node at ``x_anchor`` together with their stiffness k_ext [N/m], so that within
+    the sub-steps the force follows the node's own motion (otherwise a light node under stiff contacts
+    would be driven unstably by forces held over the whole coupling interval).
 
     A rigid frictionless plane (point ``plane[0]``, unit normal ``plane[1]``) pushes contact nodes
     that penetrate it with the penalty force k_p * penetration along the normal (``plane_k`` = 0: off).
     """
     c1 = 1.0 - 0.5 * damping * dt
     c2 = 1.0 / (1.0 + 0.5 * damping * dt)
-    f = f_ext[n] + mass[n] * gravity
+    f = f_ext[n] + mass[n] * gravity - k_ext[n] * (x[n] - x_anchor[n])
     if plane_k > 0.0 and contact[n]:
         depth = (plane[0] - x[n]).dot(plane[1])
         if depth > 0.0:
@@ -62,9 +71,11 @@ def node_update(
     f_tot[n] = f
     m_tot[n] = m
     if free[n]:
-        v[n] = (c1 * v[n] + (dt / mass[n]) * f) * c2
+        spin = hub[HUB_SPIN]
+        v_rigid = hub[HUB_VELOCITY] + spin.cross(x[n] - hub[HUB_POSITION])
+        v[n] = v_rigid + (c1 * (v[n] - v_rigid) + (dt / mass[n]) * f) * c2
         x[n] += dt * v[n]
-        w[n] = (c1 * w[n] + (dt / inertia[n]) * m) * c2
+        w[n] = spin + (c1 * (w[n] - spin) + (dt / inertia[n]) * m) * c2
         rot[n] = exp_so3(dt * w[n]) @ rot[n]
 
 

@@ -22,13 +22,13 @@ from .shell import shell_element
 @ti.kernel
 def nodes_parallel(
     n_nodes: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(),
-    w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32, f_ext: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32,
+    w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32, f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32,
     slot_list: nd_i32, slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3, plane: nd_vec3,
-    plane_k: ti.f64, contact: nd_i32,
+    plane_k: ti.f64, contact: nd_i32, hub: nd_vec3,
 ):
     for n in range(n_nodes):
-        itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, m_ext, slot_start,
-                        slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact)
+        itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor, m_ext, slot_start,
+                        slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact, hub)
 
 
 @ti.kernel
@@ -47,7 +47,8 @@ def hub_parallel(
 def steps_serial(
     n_steps: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, kinetic: ti.i32, counts: ti.types.vector(4, ti.i32),
     x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(), w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
-    f_ext: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32, slot_f: nd_vec3, slot_m: nd_vec3,
+    f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32,
+    slot_f: nd_vec3, slot_m: nd_vec3,
     f_tot: nd_vec3, m_tot: nd_vec3,
     tri: ti.types.ndarray(), frame0: ti.types.ndarray(), local0: ti.types.ndarray(), km: ti.types.ndarray(),
     kb: ti.types.ndarray(),
@@ -63,8 +64,8 @@ def steps_serial(
         for e in range(counts[2]):
             beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * counts[1], 1)
         for n in range(counts[0]):
-            itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, m_ext, slot_start,
-                            slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact)
+            itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor, m_ext, slot_start,
+                            slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact, hub)
         if counts[3] > 0:
             itg.hub_update(dt, gravity, counts[3], hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
             for k in range(counts[3]):

@@ -88,7 +88,8 @@ class Structure:
     hub_mass, hub_inertia: the hub's own mass [kg] and principal inertia (Ixx, Iyy, Izz) [kg m^2],
         added to those of its nodes.
     rigid: tie every node to the hub (rigid variant: no element is evaluated).
-    damping: mass-proportional damping coefficient a [1/s] (force -a m v on every node).
+    damping: mass-proportional damping coefficient a [1/s]: force -a m (v - v_hub) on every free node,
+        with v_hub the hub's rigid-body velocity at the node (absolute velocity when there is no hub).
     gravity: acceleration of gravity [m/s^2] (vector).
     safety: fraction of the critical step used by :meth:`advance` (0 < safety <= 1).
     arch: Taichi backend (see :func:`wheelsoil.runtime.init`).
@@ -187,6 +188,8 @@ class Structure:
         d["inertia"] = _nd(ti.f64, np.where(self.inertia > 0, self.inertia, 1.0))
         d["free"] = _nd(ti.i32, (~tied).astype(np.int32))
         d["f_ext"] = _vec(np.zeros((n, 3)))
+        d["k_ext"] = _nd(ti.f64, np.zeros(n))
+        d["x_anchor"] = _vec(mesh.nodes)
         d["m_ext"] = _vec(np.zeros((n, 3)))
         d["f_tot"] = _vec(np.zeros((n, 3)))
         d["m_tot"] = _vec(np.zeros((n, 3)))
@@ -274,7 +277,7 @@ class Structure:
             for done in range(0, n_steps, self.MAX_STEPS_PER_LAUNCH):
                 stepper.steps_serial(
                     min(self.MAX_STEPS_PER_LAUNCH, n_steps - done), dt, self.damping, g, int(kinetic_damping), counts,
-                    d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"], d["free"], d["f_ext"], d["m_ext"],
+                    d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"], d["free"], d["f_ext"], d["k_ext"], d["x_anchor"], d["m_ext"],
                     d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"], d["f_tot"], d["m_tot"],
                     d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
                     d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
@@ -286,8 +289,8 @@ class Structure:
                 self._launch_element_forces()
                 stepper.nodes_parallel(
                     self.mesh.n_nodes, dt, self.damping, g, d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
-                    d["free"], d["f_ext"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
-                    d["f_tot"], d["m_tot"], d["plane"], self._plane_k, d["contact"])
+                    d["free"], d["f_ext"], d["k_ext"], d["x_anchor"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
+                    d["f_tot"], d["m_tot"], d["plane"], self._plane_k, d["contact"], d["hub"])
                 if n_hub:
                     stepper.hub_parallel(n_hub, dt, g, d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"],
                                          d["hub_scalar"], d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
@@ -421,6 +424,18 @@ class Structure:
         return f, m
 
     # ------------------------------------------------------------------ state out
+    def device_arrays(self) -> dict:
+        """The Taichi ndarrays a coupling reads and writes (valid for the structure's lifetime).
+
+        ``x``, ``v``, ``w``: node positions [m], velocities [m/s] and spins [rad/s]; ``f_ext``,
+        ``m_ext``: external nodal forces [N] and moments [N m], held over :meth:`advance` (a coupling
+        may write them in place instead of passing arrays); ``k_ext`` [N/m], ``x_anchor`` [m]: the
+        stiffness of those forces and the node positions they were evaluated at (the node feels
+        f_ext - k_ext (x - x_anchor)); ``mass``: lumped node masses [kg]; ``hub``: the hub state rows
+        (``flexwheel.integrator.HUB_*``; row 0 is the hub centre).
+        """
+        return {k: self._dev[k] for k in ("x", "v", "w", "f_ext", "m_ext", "k_ext", "x_anchor", "mass", "hub")}
+
     def positions(self) -> np.ndarray:
         """Node positions (N, 3) [m]."""
         return self._dev["x"].to_numpy()

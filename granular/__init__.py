@@ -25,7 +25,7 @@ from .materials import (
     restitution_damping_ratio,
 )
 from .runtime import init
-from .scene import Scene, Wall
+from .scene import DeviceState, Interaction, Scene, Wall
 from .timestep import TimeStepEstimate, estimate_time_step
 
 __all__ = [
@@ -41,6 +41,8 @@ __all__ = [
     "SOIL_SOIL",
     "SOIL_STEEL",
     "STEEL",
+    "DeviceState",
+    "Interaction",
     "Scene",
     "SimulationUnstableError",
     "TimeStepEstimate",

@@ -43,6 +43,48 @@ MAX_WALLS = 31
 
 
 @dataclass(frozen=True)
+class DeviceState:
+    """The particle state arrays a scene steps (Taichi ndarrays, one row per sphere).
+
+    For :class:`Interaction` objects that add forces from bodies the scene does not own; valid
+    until the next structural edit of the scene (adding or removing spheres or walls).
+    """
+
+    x: ti.Ndarray  # positions [m]
+    v: ti.Ndarray  # velocities [m/s]
+    w: ti.Ndarray  # angular velocities [rad/s]
+    radius: ti.Ndarray  # [m]
+    mass: ti.Ndarray  # [kg]
+    inertia: ti.Ndarray  # moments of inertia [kg m^2]
+    force: ti.Ndarray  # contact force of this step [N]; an interaction adds to it
+    torque: ti.Ndarray  # contact torque of this step [N m]; an interaction adds to it
+
+
+class Interaction:
+    """A body outside the scene that exchanges contact forces with the spheres (protocol).
+
+    The scene calls, in every step,
+
+    * ``after_drift(scene, dt)`` once the spheres have drifted to t + dt (a body advances itself
+      to t + dt here), then
+    * ``add_forces(scene, dt) -> int`` after the sphere--sphere and sphere--wall forces: it adds
+      its contact forces and torques to ``scene.device_state().force/torque`` and returns its
+      number of contacts.
+
+    ``contact_moduli`` lists the effective Young's moduli [Pa] of its contacts with the spheres so
+    that the scene's stable time step accounts for them.
+    """
+
+    contact_moduli: tuple[float, ...] = ()
+
+    def after_drift(self, scene: "Scene", dt: float) -> None:  # pragma: no cover - protocol
+        pass
+
+    def add_forces(self, scene: "Scene", dt: float) -> int:  # pragma: no cover - protocol
+        return 0
+
+
+@dataclass(frozen=True)
 class Wall:
     """An infinite rigid plane. ``normal`` points into the side where particles live.
 
@@ -147,6 +189,7 @@ class Scene:
         self.arch = runtime.init(arch)
 
         self.walls: list[Wall] = []
+        self.interactions: list[Interaction] = []
         self.time = 0.0
         self.steps_taken = 0
         self._dt: float | None = None
@@ -218,6 +261,24 @@ class Scene:
         if top:
             planes.append((hi, (0, 0, -1)))
         return [self.add_wall(p, n, material=material, pair=pair) for p, n in planes]
+
+    def add_interaction(self, interaction: Interaction) -> None:
+        """Let ``interaction`` (see :class:`Interaction`) exchange forces with the spheres every step.
+
+        The time step is re-estimated with its contact moduli (a step set earlier stays if it is
+        still stable, otherwise it is refused).
+        """
+        for name in ("after_drift", "add_forces"):
+            if not callable(getattr(interaction, name, None)):
+                raise WheelsoilInputError(f"an interaction needs an {name}(scene, dt) method; {interaction!r} has none")
+        self.interactions.append(interaction)
+        if self._dt is not None and self.n_particles:
+            self.set_time_step(min(self._dt, self.stable_time_step().stable))
+
+    def device_state(self) -> DeviceState:
+        """The device arrays the scene steps (moves the state to the device if needed)."""
+        d = self._to_device()
+        return DeviceState(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["f"], d["t"])
 
     def add_spheres(self, positions, radii, velocities=None, angular_velocities=None) -> slice:
         """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
@@ -293,6 +354,7 @@ class Scene:
             raise WheelsoilInputError("the scene has no spheres; add some before asking for a time step")
         r_min = float(self._r.min())
         wall_moduli = tuple(effective_modulus(self.material, w.material) for w in self.walls)
+        wall_moduli += tuple(float(e) for it in self.interactions for e in getattr(it, "contact_moduli", ()))
         return estimate_time_step(
             r_min,
             self.material,
@@ -341,7 +403,11 @@ class Scene:
             )
             if largest > half_skin2:
                 self._rebuild_neighbors()
+            for body in self.interactions:
+                body.after_drift(self, dt)
             self._n_contacts = self._compute_forces(dt)
+            for body in self.interactions:
+                self._n_contacts += int(body.add_forces(self, dt))
             integrator.kick(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], g, dt)
             self.time += dt
             self.steps_taken += 1

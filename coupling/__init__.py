@@ -1,0 +1,9 @@
+"""Wheel meets soil: the DE--FE contact interface, the coupled stepper and the single-wheel testbed.
+
+* :mod:`.closest_point` -- point--triangle closest point with face, edge and vertex regions;
+* :mod:`.surface` -- the wheel's contact surface (triangles, shared edges, node adjacency);
+* :mod:`.contact` -- Hertz--Mindlin particle--triangle contact (:class:`WheelContact`), forces to the
+  FE nodes by barycentric weights;
+* :mod:`.testbed` -- the rig: slip, steering angle, vertical load, protocol and measured quantities;
+* :mod:`.presets` -- seed-004 cases at full scale and reduced-scale smoke cases.
+"""

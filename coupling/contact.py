@@ -1,0 +1,290 @@
+"""The DE--FE contact interface: Hertz--Mindlin contact between spheres and the wheel's surface facets.
+
+:class:`WheelContact` is a :class:`wheelsoil.granular.Interaction`: added to a
+:class:`~wheelsoil.granular.Scene`, it advances the wheel structure over each DEM step in the
+structure's own stable sub-steps, then adds the wheel's contact forces to the spheres and hands the
+reactions to the FE nodes for the next step. That is the coupled stepper (seed 004 sec. 2.3, Fig. 3:
+the FE side advances over a DEM step with the loads of the last exchange, the DEM side evaluates the
+contacts against the wheel at its new position).
+
+Contact model, per physical contact between sphere *i* (centre p, radius r) and a facet of
+half thickness h (the contact surface lies h either side of the facet's mid-surface):
+
+* closest point c of the mid-surface triangle to p and its Voronoi region -- face, edge or vertex
+  (:mod:`.closest_point`);
+* normal n from the sphere towards the wheel: the facet normal for a face contact, (c - p)/|c - p|
+  for an edge or vertex; overlap delta = r + h - |p - c|; a face contact keeps the side of the shell
+  it began on (recorded in its history), so a sphere pressed hard never passes through the thin shell;
+* where facets share an edge or vertex, a contact is counted once: face contacts always count, an
+  edge contact only if no facet containing that edge has a face contact and no other facet already
+  gave it, a vertex contact only if no face or edge contact involves that vertex (the rule of
+  Kremmer & Favier 2001 and of LIGGGHTS' mesh walls);
+* force: the Hertz--Mindlin law of :func:`wheelsoil.granular.contact.hertz_mindlin` (seed 004
+  eqs. 3--13) with a flat partner (R* = r); the effective mass of eq. 13 pairs the sphere with the
+  wheel's apparent mass at the contact point, 1/m_c = sum_k b_k^2 / m_k over the facet's nodes (b_k the
+  barycentric weights, m_k the lumped masses; nodes tied to the hub, and a rigid wheel, count as
+  immovable); the sphere's own inertia enters the rolling-torque limiter;
+  E*, G* of the soil and the wheel material (eqs. 10, 12) and the soil--steel restitution and
+  friction of Table 1; the partner's velocity and spin at c are the barycentric interpolation of the
+  facet's nodes;
+* tangential history per physical contact (up to ``HISTORY_SLOTS`` per sphere), matched from step to
+  step by its normal;
+* transfer: the facet's nodes receive -F with the barycentric weights of c, plus the moment
+  M = -M_roll - (p + r n - c) x F as nodal forces that sum to zero (f_k = lam x s_k with s_k the corner
+  positions about the facet centroid and sum_k s_k x (lam x s_k) = M), so force *and* angular momentum
+  balance exactly between particles and wheel (action = reaction to round-off). No nodal moments
+  are applied: a shell node's small rotary inertia would make them stiff;
+* the wheel advances over a DEM step with the forces of the last evaluation, each node's force
+  linearised about the position it was evaluated at with the contacts' lumped normal stiffness
+  (f - k (x - x_eval)); holding the force constant instead lets light nodes (a coarse grouser's tip)
+  that several loaded spheres press on run unstable at the DEM step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import taichi as ti
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.flexwheel.integrator import HUB_POSITION
+from wheelsoil.flexwheel.structure import Structure
+from wheelsoil.granular.materials import (
+    SOIL_STEEL,
+    Material,
+    PairProperties,
+    effective_modulus,
+    effective_shear_modulus,
+)
+from wheelsoil.granular.scene import Interaction, Scene
+from wheelsoil.taichi_types import ivec3, vec3
+
+from . import kernels as k
+from .surface import ContactSurface
+
+#: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
+#: or two places in practice: a face, or the corner between the tread and a grouser).
+HISTORY_SLOTS = 4
+
+
+def _nd(dtype, values) -> ti.Ndarray:
+    values = np.ascontiguousarray(values)
+    elem = getattr(dtype, "ndim", 0)
+    arr = ti.ndarray(dtype=dtype, shape=values.shape[: values.ndim - elem])
+    arr.from_numpy(values)
+    return arr
+
+
+class WheelContact(Interaction):
+    """Contact between the spheres of a scene and the surface facets of a wheel structure.
+
+    Parameters
+    ----------
+    structure: the wheel (flexible or ``rigid=True``), advanced by this interface every DEM step.
+    soil: the particles' material (E, nu) for the effective moduli.
+    pair: soil--wheel restitution, static and rolling friction (default: seed 004 Table 1 soil--steel).
+    advance_structure: advance the structure over each DEM step (``False``: the wheel is held where
+        it is, e.g. to measure contact forces on a frozen wheel).
+    health_every: steps between the structure's health checks.
+    wheel_skin: how far [m] the wheel's surface may move before the candidate lists are rebuilt
+        (default: four times the scene's skin); candidates are kept within the sphere's reach plus
+        the scene's skin plus this.
+    """
+
+    def __init__(
+        self,
+        structure: Structure,
+        soil: Material,
+        pair: PairProperties = SOIL_STEEL,
+        *,
+        advance_structure: bool = True,
+        health_every: int = 200,
+        wheel_skin: float | None = None,
+    ) -> None:
+        if wheel_skin is not None and not (math.isfinite(wheel_skin) and wheel_skin > 0):
+            raise WheelsoilInputError(f"wheel_skin = {wheel_skin!r} m must be a finite number > 0")
+        self._wheel_skin_request = wheel_skin
+        if not isinstance(structure, Structure):
+            raise WheelsoilInputError(f"structure must be a flexwheel Structure, got {type(structure).__name__}")
+        if not isinstance(pair, PairProperties):
+            raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
+        self.structure = structure
+        self.surface = ContactSurface.from_mesh(structure.mesh)
+        wm = structure.mesh.material
+        wheel = Material(wm.name, youngs_modulus=wm.youngs_modulus, poisson_ratio=wm.poisson_ratio, density=wm.density)
+        self.soil = soil
+        self.pair = pair
+        self.e_eff = effective_modulus(soil, wheel)
+        self.g_eff = effective_shear_modulus(soil, wheel)
+        self.contact_moduli = (self.e_eff,)
+        self.advance_structure = bool(advance_structure)
+        self.health_every = max(1, int(health_every))
+        self.rebuilds = 0
+        self.structure_substeps = 0
+        self._steps = 0
+        self._n_contacts = 0
+        sf = self.surface
+        self._tri = _nd(ti.i32, sf.triangles.astype(np.int32))
+        self._edges = _nd(ti.i32, sf.edges.astype(np.int32))
+        self._half_t = _nd(ti.f64, sf.half_thickness)
+        self._nodes = _nd(ti.i32, sf.nodes.astype(np.int32))
+        self._corner_start = _nd(ti.i32, sf.corner_start.astype(np.int32))
+        self._corners = _nd(ti.i32, sf.corners.astype(np.int32))
+        free = np.ones(structure.mesh.n_nodes, bool)
+        free[structure.hub_nodes] = False
+        self._inv_mass = _nd(ti.f64, np.where(free & (structure.mass > 0), 1.0 / np.maximum(structure.mass, 1e-300), 0.0))
+        self._node_ref = ti.Vector.ndarray(3, ti.f64, shape=len(sf.nodes))
+        self._lo = ti.ndarray(ivec3, shape=sf.n_facets)
+        self._hi = ti.ndarray(ivec3, shape=sf.n_facets)
+        self._facet_start = ti.ndarray(ti.i32, shape=sf.n_facets + 1)
+        self._facet_fill = ti.ndarray(ti.i32, shape=sf.n_facets)
+        self._resultant = ti.Vector.ndarray(3, ti.f64, shape=5)
+        self._resultant.fill(0.0)
+        self._stats = ti.ndarray(ti.f64, shape=1)
+        self._arrays: dict = {}
+        self._scene_key = None
+        self._need_rebuild = True
+        self._seen_rebuilds = -1
+
+    # ------------------------------------------------------------------ buffers
+    def _buffer(self, name: str, dtype, size: int, *, shape_tail: tuple = ()):
+        """A scratch ndarray of at least ``size`` rows (grown by 25 % when too small)."""
+        arr = self._arrays.get(name)
+        if arr is None or arr.shape[0] < size:
+            rows = max(16, int(size * 1.25) + 16)
+            if dtype is vec3:
+                arr = ti.Vector.ndarray(3, ti.f64, shape=(rows,) + shape_tail)
+            else:
+                arr = ti.ndarray(dtype, shape=(rows,) + shape_tail)
+            self._arrays[name] = arr
+        return arr
+
+    def _attach(self, scene: Scene) -> None:
+        """(Re)allocate the per-particle arrays and the facet grid for ``scene``'s particles."""
+        n = scene.n_particles
+        radii = scene.radii
+        self.wheel_skin = self._wheel_skin_request or 4.0 * scene.skin
+        self.skin = scene.skin + self.wheel_skin  # candidate margin
+        self.r_max = float(radii.max())
+        cell = 2.0 * self.r_max + self.skin
+        extent = scene.domain_max - scene.domain_min
+        self.dims = [int(v) for v in np.maximum(1, np.ceil(extent / cell))]
+        self.origin = scene.domain_min.tolist()
+        self.inv_cell = 1.0 / cell
+        n_cells = int(np.prod(self.dims))
+        a = self._arrays
+        a.clear()
+        a["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
+        a["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
+        a["count"] = ti.ndarray(ti.i32, shape=n)
+        a["start"] = ti.ndarray(ti.i32, shape=n + 1)
+        a["active"] = ti.ndarray(ti.i32, shape=n)
+        a["hist_n"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
+        a["hist_xi"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
+        a["hist_count"] = ti.ndarray(ti.i32, shape=n)
+        a["hist_count"].fill(0)
+        self._scene_key = (id(scene), n)
+        self._n_active = 0
+        self._need_rebuild = True
+
+    def _rebuild(self, scene: Scene) -> None:
+        ds = scene.device_state()
+        w = self.structure.device_arrays()
+        a = self._arrays
+        sf = self.surface
+        dims = ivec3(*self.dims)
+        origin = vec3(*self.origin)
+        pad = self.r_max + self.skin
+        k.facet_cell_ranges(w["x"], self._tri, self._half_t, sf.n_facets, pad, origin, self.inv_cell, dims,
+                            self._lo, self._hi, a["cell_count"])
+        from wheelsoil.granular.neighbors import exclusive_scan
+
+        total = exclusive_scan(a["cell_count"], a["cell_start"])
+        cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
+        cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
+        k.fill_facet_cells(sf.n_facets, dims, self._lo, self._hi, a["cell_start"], cell_fill, cell_facets)
+        k.count_candidates(ds.x, ds.radius, self.skin, origin, self.inv_cell, dims, a["cell_start"], cell_facets,
+                           w["x"], self._tri, self._half_t, a["count"], a["hist_count"])
+        n_cand = exclusive_scan(a["count"], a["start"])
+        cand = self._buffer("cand", ti.i32, max(n_cand, 1))
+        k.fill_candidates(ds.x, ds.radius, self.skin, origin, self.inv_cell, dims, a["cell_start"], cell_facets,
+                          w["x"], self._tri, self._half_t, a["start"], cand)
+        facet_entries = self._buffer("facet_entries", ti.i32, max(n_cand, 1))
+        self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, self._facet_start,
+                                        self._facet_fill, facet_entries)
+        for name, dtype in (("code", ti.i32), ("keep", ti.i32), ("overlap", ti.f64), ("stiffness", ti.f64), ("normal", vec3),
+                            ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3)):
+            self._buffer(name, dtype, max(n_cand, 1))
+        self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
+        if self._arrays["keep"].shape[0] >= 1:
+            self._arrays["keep"].fill(0)
+        k.copy_node_positions(w["x"], self._nodes, self._node_ref)
+        self._seen_rebuilds = scene.neighbor_rebuilds
+        self._need_rebuild = False
+        self.rebuilds += 1
+
+    # ------------------------------------------------------------------ Interaction protocol
+    def after_drift(self, scene: Scene, dt: float) -> None:
+        """Advance the wheel over [t, t + dt] with the loads of the last contact evaluation."""
+        if self.advance_structure:
+            self._steps += 1
+            self.structure_substeps += self.structure.advance(dt, check=self._steps % self.health_every == 0)
+
+    def add_forces(self, scene: Scene, dt: float) -> int:
+        """Evaluate every sphere--wheel contact at the current positions (see the module docstring)."""
+        if self._scene_key != (id(scene), scene.n_particles):
+            self._attach(scene)
+        if self._need_rebuild or scene.neighbor_rebuilds != self._seen_rebuilds:
+            self._rebuild(scene)
+        ds = scene.device_state()
+        w = self.structure.device_arrays()
+        a = self._arrays
+        center = vec3(*w["hub"].to_numpy()[HUB_POSITION]) if self.structure.hub_nodes.size else vec3(0.0, 0.0, 0.0)
+        self._n_contacts = k.wheel_contacts(
+            ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.force, ds.torque,
+            self._n_active, a["active"], a["start"], a["cand"],
+            a["code"], a["keep"], a["bary"], a["normal"], a["overlap"], a["f_wheel"], a["m_wheel"], a["xi_new"], a["stiffness"],
+            a["hist_n"], a["hist_xi"], a["hist_count"],
+            w["x"], w["v"], w["w"], self._inv_mass, self._tri, self._edges, self._half_t,
+            self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
+            w["f_ext"], w["k_ext"], w["x_anchor"], self._node_ref, center, self._resultant,
+            self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
+            dt, self._stats,
+        )
+        # rebuild before the wheel's surface has moved its skin (less a margin for one more step)
+        if self._stats.to_numpy()[0] > (0.8 * self.wheel_skin) ** 2:
+            self._need_rebuild = True
+        return self._n_contacts
+
+    # ------------------------------------------------------------------ measured quantities
+    @property
+    def contact_count(self) -> int:
+        """Physical sphere--wheel contacts at the last evaluation."""
+        return int(self._n_contacts)
+
+    @property
+    def active_particles(self) -> int:
+        """Spheres within reach of the wheel (with candidate facets) since the last rebuild."""
+        return int(self._n_active) if self._arrays else 0
+
+    def resultant(self) -> tuple[np.ndarray, np.ndarray]:
+        """Force [N] of the soil on the wheel and its moment [N m] about the hub centre, last evaluation."""
+        r = self._resultant.to_numpy()
+        return r[k.RES_FORCE].copy(), r[k.RES_MOMENT].copy()
+
+    def mean_resultant(self, reset: bool = True) -> tuple[np.ndarray, np.ndarray, int]:
+        """Force and moment of :meth:`resultant` averaged over every evaluation since the last reset,
+        and the number of evaluations."""
+        r = self._resultant.to_numpy()
+        samples = int(round(r[k.RES_SAMPLES][0]))
+        scale = 1.0 / max(samples, 1)
+        out = r[k.RES_FORCE_SUM] * scale, r[k.RES_MOMENT_SUM] * scale, samples
+        if reset:
+            r[k.RES_FORCE_SUM:] = 0.0
+            self._resultant.from_numpy(r)
+        return out
+
+    def nodal_forces(self) -> np.ndarray:
+        """Contact forces [N] on every structure node at the last evaluation, (N, 3)."""
+        return self.structure.device_arrays()["f_ext"].to_numpy()

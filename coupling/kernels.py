@@ -1,0 +1,392 @@
+"""Taichi kernels of the particle--wheel contact interface (see :mod:`.contact` for the physics).
+
+Two kinds of work:
+
+* *Rebuild* (when particles or the wheel have moved far enough): bin the contact facets into a
+  uniform grid, list for every particle the facets within its reach plus a skin (its *candidates*,
+  sorted by facet so that results do not depend on thread scheduling), compact the particles that
+  have candidates into an *active* list, and transpose the candidate list per facet.
+* *Every step* (:func:`wheel_contacts`): per active particle, classify each candidate by the
+  Voronoi region of its closest point (face, edge, vertex), keep each physical contact once,
+  evaluate the Hertz--Mindlin law with the contact's tangential history, and add force and torque to
+  the particle; then per surface node gather the reactions of the contacts on its facets (the force
+  by barycentric weights plus the self-equilibrated nodal forces carrying the contact's moment; a
+  gather: no floating-point atomics), with the contacts' normal stiffness lumped to the nodes (the
+  structure lets the held force follow the node's motion within its sub-steps, which keeps light
+  nodes under stiff contacts stable), and sum the resultant on the wheel.
+"""
+
+import taichi as ti
+
+from wheelsoil.granular.contact import hertz_mindlin
+from wheelsoil.taichi_types import ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
+
+from .closest_point import EDGE_AB, EDGE_CA, FACE, VERTEX_A, closest_point_on_triangle
+
+nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
+nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
+
+#: Rows of the resultant array: force and moment of this step, their running sums, sample count.
+RES_FORCE, RES_MOMENT, RES_FORCE_SUM, RES_MOMENT_SUM, RES_SAMPLES = range(5)
+
+
+@ti.func
+def _corners(xw: ti.template(), tri: ti.template(), s: ti.i32):
+    return xw[tri[s, 0]], xw[tri[s, 1]], xw[tri[s, 2]]
+
+
+@ti.func
+def _cell_of(p: vec3, origin: vec3, inv_cell: ti.f64, dims: ivec3) -> ivec3:
+    c = ti.cast(ti.floor((p - origin) * inv_cell), ti.i32)
+    return ti.max(0, ti.min(c, dims - 1))
+
+
+@ti.func
+def _flat(c: ivec3, dims: ivec3) -> ti.i32:
+    return (c[0] * dims[1] + c[1]) * dims[2] + c[2]
+
+
+@ti.kernel
+def facet_cell_ranges(
+    xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, n_facets: ti.i32, pad: ti.f64, origin: vec3, inv_cell: ti.f64,
+    dims: ivec3, lo: nd_ivec3, hi: nd_ivec3, cell_count: nd_i32,
+):
+    """Cell range of every facet's box grown by ``pad`` + half thickness; count facets per cell."""
+    for c in cell_count:
+        cell_count[c] = 0
+    for s in range(n_facets):
+        a, b, c = _corners(xw, tri, s)
+        grow = pad + half_t[s]
+        mn = ti.min(a, b, c) - grow
+        mx = ti.max(a, b, c) + grow
+        top = origin + ti.cast(dims, ti.f64) / inv_cell
+        l = ivec3(1, 1, 1)
+        h = ivec3(0, 0, 0)  # empty unless the box meets the grid
+        if (mx >= origin).all() and (mn <= top).all():
+            l = _cell_of(mn, origin, inv_cell, dims)
+            h = _cell_of(mx, origin, inv_cell, dims)
+            for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
+                ti.atomic_add(cell_count[_flat(ivec3(i, j, k), dims)], 1)
+        lo[s] = l
+        hi[s] = h
+
+
+@ti.kernel
+def fill_facet_cells(
+    n_facets: ti.i32, dims: ivec3, lo: nd_ivec3, hi: nd_ivec3, cell_start: nd_i32, cell_fill: nd_i32,
+    cell_facets: nd_i32,
+):
+    for c in cell_fill:
+        cell_fill[c] = 0
+    for s in range(n_facets):
+        l = lo[s]
+        h = hi[s]
+        for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
+            c = _flat(ivec3(i, j, k), dims)
+            cell_facets[cell_start[c] + ti.atomic_add(cell_fill[c], 1)] = s
+
+
+@ti.func
+def _within_reach(p: vec3, reach: ti.f64, xw: ti.template(), tri: ti.template(), s: ti.i32) -> ti.i32:
+    a, b, c = _corners(xw, tri, s)
+    bary, _ = closest_point_on_triangle(p, a, b, c)
+    q = bary[0] * a + bary[1] * b + bary[2] * c
+    return ti.cast((p - q).norm_sqr() < reach * reach, ti.i32)
+
+
+@ti.kernel
+def count_candidates(
+    x: nd_vec3, radius: nd_f64, skin: ti.f64, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_start: nd_i32,
+    cell_facets: nd_i32, xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, count: nd_i32, hist_count: nd_i32,
+) -> ti.i32:
+    """Number of facets within radius + half thickness + skin of each particle; returns the largest.
+
+    A particle with no candidates forgets its wheel-contact history (it has left the wheel)."""
+    most = 0
+    for i in x:
+        c = _flat(_cell_of(x[i], origin, inv_cell, dims), dims)
+        k = 0
+        for q in range(cell_start[c], cell_start[c + 1]):
+            s = cell_facets[q]
+            k += _within_reach(x[i], radius[i] + half_t[s] + skin, xw, tri, s)
+        count[i] = k
+        if k == 0:
+            hist_count[i] = 0
+        ti.atomic_max(most, k)
+    return most
+
+
+@ti.kernel
+def fill_candidates(
+    x: nd_vec3, radius: nd_f64, skin: ti.f64, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_start: nd_i32,
+    cell_facets: nd_i32, xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, start: nd_i32, cand: nd_i32,
+):
+    """Write each particle's candidate facets, sorted ascending (insertion sort: lists are short)."""
+    for i in x:
+        e0 = start[i]
+        e1 = start[i + 1]
+        if e1 > e0:
+            c = _flat(_cell_of(x[i], origin, inv_cell, dims), dims)
+            k = e0
+            for q in range(cell_start[c], cell_start[c + 1]):
+                s = cell_facets[q]
+                if _within_reach(x[i], radius[i] + half_t[s] + skin, xw, tri, s):
+                    cand[k] = s
+                    k += 1
+            for a in range(e0 + 1, e1):
+                key = cand[a]
+                b = a - 1
+                while b >= e0 and cand[b] > key:
+                    cand[b + 1] = cand[b]
+                    b -= 1
+                cand[b + 1] = key
+
+
+@ti.kernel
+def index_active(
+    count: nd_i32, start: nd_i32, active: nd_i32, n_facets: ti.i32, cand: nd_i32, facet_start: nd_i32,
+    facet_fill: nd_i32, facet_entries: nd_i32,
+) -> ti.i32:
+    """Compact the particles with candidates into ``active`` and list every facet's candidate entries
+    (serial: the order is deterministic). Returns the number of active particles."""
+    n_active = 0
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        for s in range(n_facets + 1):
+            facet_start[s] = 0
+        for i in range(count.shape[0]):
+            if count[i] > 0:
+                active[n_active] = i
+                n_active += 1
+                for e in range(start[i], start[i + 1]):
+                    facet_start[cand[e] + 1] += 1
+        for s in range(n_facets):
+            facet_start[s + 1] += facet_start[s]
+            facet_fill[s] = facet_start[s]
+        for a in range(n_active):
+            i = active[a]
+            for e in range(start[i], start[i + 1]):
+                s = cand[e]
+                facet_entries[facet_fill[s]] = e
+                facet_fill[s] += 1
+    return n_active
+
+
+@ti.kernel
+def copy_node_positions(xw: nd_vec3, nodes: nd_i32, ref: nd_vec3):
+    for u in nodes:
+        ref[u] = xw[nodes[u]]
+
+
+@ti.func
+def _shares_edge(edges: ti.template(), s: ti.i32, edge: ti.i32) -> ti.i32:
+    return ti.cast(edges[s, 0] == edge or edges[s, 1] == edge or edges[s, 2] == edge, ti.i32)
+
+
+@ti.func
+def _has_node(tri: ti.template(), s: ti.i32, node: ti.i32) -> ti.i32:
+    return ti.cast(tri[s, 0] == node or tri[s, 1] == node or tri[s, 2] == node, ti.i32)
+
+
+@ti.kernel
+def wheel_contacts(
+    # particles
+    x: nd_vec3, v: nd_vec3, omega: nd_vec3, radius: nd_f64, mass: nd_f64, inertia: nd_f64,
+    force: nd_vec3, torque: nd_vec3,
+    # candidates
+    n_active: ti.i32, active: nd_i32, start: nd_i32, cand: nd_i32,
+    # per-entry scratch
+    code: nd_i32, keep: nd_i32, bary: nd_f64_2d, normal: nd_vec3, overlap: nd_f64, f_wheel: nd_vec3,
+    m_wheel: nd_vec3, xi_new: nd_vec3, stiffness: nd_f64,
+    # contact history per particle
+    hist_n: nd_vec3_2d, hist_xi: nd_vec3_2d, hist_count: nd_i32,
+    # wheel
+    xw: nd_vec3, vw: nd_vec3, ww: nd_vec3, inv_mass_w: nd_f64, tri: nd_i32_2d, edges: nd_i32_2d, half_t: nd_f64,
+    nodes: nd_i32, corner_start: nd_i32, corners: nd_i32, facet_start: nd_i32, facet_entries: nd_i32,
+    f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, node_ref: nd_vec3, center: vec3, resultant: nd_vec3,
+    # contact law
+    e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, dt: ti.f64,
+    stats: nd_f64,
+) -> ti.i32:
+    """One evaluation of every particle--wheel contact; returns the number of contacts.
+
+    ``stats[0]`` receives the largest squared displacement of a surface node since the last rebuild.
+    """
+    n_contacts = 0
+    for _ in range(1):
+        stats[0] = 0.0
+    for a in range(n_active):
+        i = active[a]
+        p = x[i]
+        ri = radius[i]
+        e0 = start[i]
+        e1 = start[i + 1]
+        # (A) geometry of each candidate: closest feature, normal (particle -> wheel), overlap
+        for e in range(e0, e1):
+            s = cand[e]
+            ca, cb, cc = _corners(xw, tri, s)
+            w, feature = closest_point_on_triangle(p, ca, cb, cc)
+            d = p - (w[0] * ca + w[1] * cb + w[2] * cc)
+            reach = ri + half_t[s]
+            kind = -1
+            n = vec3(0.0, 0.0, 1.0)
+            depth = 0.0
+            if feature == FACE:
+                nf = (cb - ca).cross(cc - ca).normalized()
+                sd = d.dot(nf)
+                n = -nf if sd >= 0.0 else nf
+                depth = reach - ti.abs(sd)
+            else:
+                dist = d.norm()
+                if dist > 0.0:
+                    n = -d / dist
+                depth = reach - dist
+            if depth > 0.0:
+                kind = feature
+            code[e] = kind
+            overlap[e] = depth
+            normal[e] = n
+            for k in ti.static(range(3)):
+                bary[e, k] = w[k]
+        # (B) count each physical contact once where facets share an edge or a vertex
+        for e in range(e0, e1):
+            kept = 0
+            kind = code[e]
+            if kind == FACE:
+                kept = 1
+            elif kind >= EDGE_AB and kind <= EDGE_CA:
+                s = cand[e]
+                edge = edges[s, kind - EDGE_AB]
+                kept = 1
+                for e2 in range(e0, e1):
+                    k2 = code[e2]
+                    s2 = cand[e2]
+                    if k2 == FACE and _shares_edge(edges, s2, edge):
+                        kept = 0
+                    elif e2 < e and k2 >= EDGE_AB and k2 <= EDGE_CA and edges[s2, k2 - EDGE_AB] == edge:
+                        kept = 0
+            elif kind >= VERTEX_A:
+                s = cand[e]
+                node = tri[s, kind - VERTEX_A]
+                kept = 1
+                for e2 in range(e0, e1):
+                    k2 = code[e2]
+                    s2 = cand[e2]
+                    if k2 == FACE and _has_node(tri, s2, node):
+                        kept = 0
+                    elif k2 >= EDGE_AB and k2 <= EDGE_CA:
+                        j = k2 - EDGE_AB
+                        if tri[s2, j] == node or tri[s2, (j + 1) % 3] == node:
+                            kept = 0
+                    elif e2 < e and k2 >= VERTEX_A and tri[s2, k2 - VERTEX_A] == node:
+                        kept = 0
+            keep[e] = kept
+        # (C) Hertz--Mindlin on each kept contact, history matched by contact normal
+        f_total = vec3(0.0)
+        t_total = vec3(0.0)
+        n_old = hist_count[i]
+        claimed = 0
+        n_kept = 0
+        for e in range(e0, e1):
+            if keep[e]:
+                s = cand[e]
+                n = normal[e]
+                depth = overlap[e]
+                best = -1
+                best_score = 0.5  # cos 60 deg: a contact's normal turns far less in one step
+                for k in range(n_old):
+                    if ((claimed >> k) & 1) == 0:
+                        score = n.dot(hist_n[i, k])
+                        if code[e] == FACE:
+                            score = ti.abs(score)
+                        if score > best_score:
+                            best_score = score
+                            best = k
+                xi = vec3(0.0)
+                if best >= 0:
+                    claimed |= 1 << best
+                    xi = hist_xi[i, best]
+                    if code[e] == FACE and n.dot(hist_n[i, best]) < 0.0:
+                        # the contact stays on the side of the shell it began on (no tunnelling)
+                        n = -n
+                        depth = 2.0 * (ri + half_t[s]) - depth
+                i0 = tri[s, 0]
+                i1 = tri[s, 1]
+                i2 = tri[s, 2]
+                b0 = bary[e, 0]
+                b1 = bary[e, 1]
+                b2 = bary[e, 2]
+                point = b0 * xw[i0] + b1 * xw[i1] + b2 * xw[i2]
+                v_wheel = b0 * vw[i0] + b1 * vw[i1] + b2 * vw[i2]
+                w_wheel = b0 * ww[i0] + b1 * ww[i1] + b2 * ww[i2]
+                # effective mass (eq. 13) with the wheel's apparent mass at the contact point: a force F
+                # at c moves the lumped nodes by b_k F / m_k, so 1/m_c = sum b_k^2 / m_k (tied nodes: 0)
+                inv_mc = b0 * b0 * inv_mass_w[i0] + b1 * b1 * inv_mass_w[i1] + b2 * b2 * inv_mass_w[i2]
+                m_eff = 1.0 / (1.0 / mass[i] + inv_mc)
+                fc, tn, m_roll, xi_out = hertz_mindlin(
+                    n, depth, v[i] + omega[i].cross(ri * n) - v_wheel, omega[i] - w_wheel,
+                    ri, m_eff, inertia[i], e_eff, g_eff, beta, mu_s, mu_r, xi, dt,
+                )
+                f_total += fc
+                t_total += ri * tn + m_roll
+                f_wheel[e] = -fc
+                stiffness[e] = 2.0 * e_eff * ti.sqrt(ri * depth)  # S_n = dF_n/d(delta_n)
+                # The moment the wheel must also receive for angular momentum to balance exactly: the
+                # particle's torque about the origin is (p + r n) x F + M_roll, the wheel receives -F at
+                # ``point``. It goes to the facet's nodes as a self-equilibrated set of forces (no nodal
+                # moments: a shell node's small rotary inertia would make them stiff):
+                # f_k = lam x s_k, s_k = x_k - centroid, J lam = M, J = sum(|s_k|^2 I - s_k s_k^T).
+                moment = -m_roll - (p + ri * n - point).cross(fc)
+                centroid = (xw[i0] + xw[i1] + xw[i2]) / 3.0
+                jac = ti.Matrix.zero(ti.f64, 3, 3)
+                for q in ti.static(range(3)):
+                    sk = xw[tri[s, q]] - centroid
+                    jac += sk.dot(sk) * ti.Matrix.identity(ti.f64, 3) - sk.outer_product(sk)
+                m_wheel[e] = jac.inverse() @ moment
+                normal[e] = n
+                xi_new[e] = xi_out
+                n_kept += 1
+        n_contacts += n_kept
+        # (D) the history of this step's contacts
+        slots = 0
+        for e in range(e0, e1):
+            if keep[e] and slots < hist_n.shape[1]:
+                hist_n[i, slots] = normal[e]
+                hist_xi[i, slots] = xi_new[e]
+                slots += 1
+        hist_count[i] = slots
+        force[i] += f_total
+        torque[i] += t_total
+    # nodes gather the reactions of the contacts on their facets
+    for u in nodes:
+        node = nodes[u]
+        f = vec3(0.0)
+        stiff = 0.0
+        for q in range(corner_start[u], corner_start[u + 1]):
+            s = corners[q] // 3
+            k = corners[q] % 3
+            arm = xw[node] - (xw[tri[s, 0]] + xw[tri[s, 1]] + xw[tri[s, 2]]) / 3.0
+            for j in range(facet_start[s], facet_start[s + 1]):
+                e = facet_entries[j]
+                if keep[e]:
+                    f += bary[e, k] * f_wheel[e] + m_wheel[e].cross(arm)
+                    stiff += bary[e, k] * stiffness[e]
+        f_ext[node] = f
+        k_ext[node] = stiff
+        x_anchor[node] = xw[node]
+        ti.atomic_max(stats[0], (xw[node] - node_ref[u]).norm_sqr())
+    # resultant on the wheel: force and moment about ``center`` (serial sum: deterministic)
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        f = vec3(0.0)
+        m = vec3(0.0)
+        for u in range(nodes.shape[0]):
+            node = nodes[u]
+            f += f_ext[node]
+            m += (xw[node] - center).cross(f_ext[node])
+        resultant[RES_FORCE] = f
+        resultant[RES_MOMENT] = m
+        resultant[RES_FORCE_SUM] += f
+        resultant[RES_MOMENT_SUM] += m
+        resultant[RES_SAMPLES] += vec3(1.0, 0.0, 0.0)
+    return n_contacts

@@ -1,0 +1,105 @@
+"""The single-wheel testbed at a tiny scale: force balance, signs, no particle inside the wheel, bad input."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from wheelsoil.coupling.surface import ContactSurface
+from wheelsoil.coupling.testbed import Testbed, TestbedSpec, detect_steady_state
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.flexwheel.geometry import WheelGeometry
+from wheelsoil.flexwheel.material import SEED004_WHEEL
+from wheelsoil.granular import BedSpec, prepare_bed
+
+#: A small flexible wheel (r = 0.15 m, b = 0.1 m, 8 grousers) of the seed-004 wheel material.
+MINI_WHEEL = WheelGeometry(
+    name="mini", radius=0.15, width=0.1, tread_thickness=0.002, hub_radius=0.05, spokes_per_row=6,
+    spoke_thickness=0.003, spoke_bow=0.1, grouser_count=8, grouser_height=0.008, grouser_thickness=0.002,
+    material=SEED004_WHEEL, element_size=0.025, hub_mass=1.0,
+)
+MINI_BED = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015)
+MINI_RUN = TestbedSpec(slip=0.3, slip_angle=10.0, load=80.0, angular_velocity=2.0, settle_time=0.05,
+                       drive_time=0.3, steady_window=0.08)
+
+
+@pytest.fixture(scope="module")
+def mini_bed(tmp_path_factory):
+    return prepare_bed(MINI_BED, cache_dir=tmp_path_factory.mktemp("beds"))
+
+
+@pytest.fixture(scope="module")
+def steering_run(mini_bed):
+    bench = Testbed(mini_bed, MINI_WHEEL, MINI_RUN)
+    return bench, bench.run()
+
+
+def test_steady_state_force_balance_and_signs(steering_run):
+    bench, result = steering_run
+    s = result.summary
+    w = MINI_RUN.load
+    # the axle is free vertically under W: in steady state the soil carries W
+    assert s["vertical_force"]["mean"] == pytest.approx(w, rel=0.15)
+    # the rig commands slip and slip angle exactly
+    assert s["slip"]["mean"] == pytest.approx(0.3, abs=1e-9)
+    assert s["slip_angle"]["mean"] == pytest.approx(10.0, abs=1e-9)
+    # a driven wheel at 30 % slip pulls and needs torque; the soil resists the lateral slip (v_y > 0)
+    assert s["drawbar_pull"]["mean"] > 0.0
+    assert s["torque"]["mean"] > 0.0
+    assert s["lateral_force"]["mean"] < 0.0
+    assert 0.0 < s["sinkage"]["mean"] < 0.5 * MINI_WHEEL.radius
+    # series are complete and finite
+    n = len(result.series["t"])
+    assert all(len(v) == n and np.all(np.isfinite(v)) for v in result.series.values())
+    assert result.info["fe_substeps"] >= result.info["dem_steps"]
+
+
+def test_no_particle_inside_the_wheel(steering_run):
+    bench, result = steering_run
+    surface = ContactSurface.from_mesh(bench.mesh)
+    x, r = result.final_particles["position"], result.final_particles["radius"]
+    hub = bench.structure.hub_position
+    near = np.linalg.norm(x - hub, axis=1) < MINI_WHEEL.radius + MINI_WHEEL.grouser_height + 0.02
+    dist, facet = surface.closest_distance(x[near], result.final_wheel_nodes)
+    # every centre stays outside the shell by most of its radius (overlaps are a small fraction of r)
+    assert np.all(dist > 0.5 * r[near] + surface.half_thickness[facet])
+
+
+def test_steady_state_detection_finds_the_plateau():
+    t = np.linspace(0, 2, 401)
+    rng = np.random.default_rng(0)
+    y = 100 * (1 - np.exp(-t / 0.2)) + rng.normal(0, 2, t.size)
+    k, steady = detect_steady_state(t, {"y": y}, start=0.0, window=0.2, tolerance=0.05, scales={"y": 5.0})
+    assert steady and 0.3 < t[k] < 1.0
+    ramp = 100 * t
+    k, steady = detect_steady_state(t, {"y": ramp}, start=0.0, window=0.2, tolerance=0.05, scales={"y": 5.0})
+    assert not steady
+
+
+@pytest.mark.parametrize(
+    "change, key",
+    [
+        (dict(slip=1.0), "slip"),
+        (dict(slip=-1.5), "slip"),
+        (dict(slip_angle=90.0), "slip_angle"),
+        (dict(slip_angle=-95.0), "slip_angle"),
+        (dict(load=0.0), "load"),
+        (dict(load=-10.0), "load"),
+        (dict(angular_velocity=0.0), "angular_velocity"),
+        (dict(drive_time=float("nan")), "drive_time"),
+    ],
+)
+def test_bad_rig_settings_name_the_key_value_and_range(change, key):
+    with pytest.raises(WheelsoilInputError, match=rf"testbed {key} = .* allowed"):
+        replace(MINI_RUN, **change)
+
+
+def test_wheel_wider_than_the_bin_short_bin_and_missing_bed_are_refused(mini_bed, tmp_path):
+    with pytest.raises(WheelsoilInputError, match="does not fit the bed width"):
+        Testbed(mini_bed, replace(MINI_WHEEL, width=0.3), MINI_RUN)
+    with pytest.raises(WheelsoilInputError, match="does not fit the bed width"):
+        Testbed(mini_bed, replace(MINI_WHEEL, width=0.2), replace(MINI_RUN, slip_angle=30.0))
+    with pytest.raises(WheelsoilInputError, match="too short"):
+        Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, drive_time=5.0))
+    with pytest.raises(WheelsoilInputError, match="does not exist"):
+        Testbed(tmp_path / "missing.h5", MINI_WHEEL, MINI_RUN)
