@@ -58,7 +58,9 @@ from wheelsoil.granular.materials import (
     effective_shear_modulus,
 )
 from wheelsoil.granular.scene import Interaction, Scene
+from wheelsoil.granular.neighbors import exclusive_scan
 from wheelsoil.taichi_types import ivec3, vec3
+from wheelsoil.taichi_types import to_ndarray as _nd
 
 from . import kernels as k
 from .surface import ContactSurface
@@ -66,14 +68,6 @@ from .surface import ContactSurface
 #: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
 #: or two places in practice: a face, or the corner between the tread and a grouser).
 HISTORY_SLOTS = 4
-
-
-def _nd(dtype, values) -> ti.Ndarray:
-    values = np.ascontiguousarray(values)
-    elem = getattr(dtype, "ndim", 0)
-    arr = ti.ndarray(dtype=dtype, shape=values.shape[: values.ndim - elem])
-    arr.from_numpy(values)
-    return arr
 
 
 class WheelContact(Interaction):
@@ -198,8 +192,6 @@ class WheelContact(Interaction):
         pad = self.r_max + self.skin
         k.facet_cell_ranges(w["x"], self._tri, self._half_t, sf.n_facets, pad, origin, self.inv_cell, dims,
                             self._lo, self._hi, a["cell_count"])
-        from wheelsoil.granular.neighbors import exclusive_scan
-
         total = exclusive_scan(a["cell_count"], a["cell_start"])
         cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
         cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
@@ -217,8 +209,7 @@ class WheelContact(Interaction):
                             ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3)):
             self._buffer(name, dtype, max(n_cand, 1))
         self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
-        if self._arrays["keep"].shape[0] >= 1:
-            self._arrays["keep"].fill(0)
+        self._arrays["keep"].fill(0)
         k.copy_node_positions(w["x"], self._nodes, self._node_ref)
         self._seen_rebuilds = scene.neighbor_rebuilds
         self._need_rebuild = False

@@ -70,12 +70,13 @@ class ContactSurface:
     def closest_distance(self, points: np.ndarray, node_positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distance from every point to the nearest facet mid-surface [m] and that facet's index.
 
-        Brute force in NumPy (for checks and tests; the solver uses a grid on the device).
+        Brute force over every facet (for checks and tests; the solver uses a grid on the device).
         """
-        from .closest_point import closest_points  # Taichi kernel
         import taichi as ti
 
-        from wheelsoil.taichi_types import vec3
+        from wheelsoil.taichi_types import to_ndarray, vec3
+
+        from .closest_point import closest_points  # Taichi kernel
 
         p = np.asarray(points, float).reshape(-1, 3)
         corners = node_positions[self.triangles]  # (S, 3, 3)
@@ -85,14 +86,10 @@ class ContactSurface:
         for s in range(0, len(p), chunk):
             q = p[s : s + chunk]
             rows = len(q) * self.n_facets
-            arrays = {}
-            for key, val in (("p", np.repeat(q, self.n_facets, axis=0)), ("a", np.tile(corners[:, 0], (len(q), 1))),
-                             ("b", np.tile(corners[:, 1], (len(q), 1))), ("c", np.tile(corners[:, 2], (len(q), 1)))):
-                arrays[key] = ti.ndarray(vec3, shape=rows)
-                arrays[key].from_numpy(np.ascontiguousarray(val))
+            tri = [to_ndarray(vec3, np.tile(corners[:, k], (len(q), 1))) for k in range(3)]
             bary = ti.ndarray(vec3, shape=rows)
             feat = ti.ndarray(ti.i32, shape=rows)
-            closest_points(arrays["p"], arrays["a"], arrays["b"], arrays["c"], bary, feat)
+            closest_points(to_ndarray(vec3, np.repeat(q, self.n_facets, axis=0)), *tri, bary, feat)
             w = bary.to_numpy().reshape(len(q), self.n_facets, 3)
             cpt = np.einsum("psk,skd->psd", w, corners)
             dist = np.linalg.norm(cpt - q[:, None, :], axis=2)

@@ -18,6 +18,7 @@ import taichi as ti
 from wheelsoil import runtime
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat9, mat32, vec3, vec4
+from wheelsoil.taichi_types import to_ndarray as _nd
 
 from . import integrator as itg
 from . import stepper
@@ -27,17 +28,6 @@ from .shell import shell_energies, shell_forces, shell_setup
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
-
-
-def _nd(dtype, values) -> ti.Ndarray:
-    """A Taichi ndarray holding ``values`` (element shape taken from ``dtype``)."""
-    values = np.ascontiguousarray(values)
-    if values.shape[0] == 0:  # Taichi has no empty arrays; kernels are never launched over these
-        values = np.zeros((1,) + values.shape[1:], dtype=values.dtype)
-    elem_ndim = getattr(dtype, "ndim", 0)
-    arr = ti.ndarray(dtype=dtype, shape=values.shape[: values.ndim - elem_ndim])
-    arr.from_numpy(values)
-    return arr
 
 
 def _vec(values):

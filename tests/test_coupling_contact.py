@@ -17,16 +17,10 @@ from wheelsoil.flexwheel.shapes import strip
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular import LUNAR_SOIL_SIMULANT, SOIL_STEEL, Material, PairProperties, Scene
 from wheelsoil.granular.materials import effective_modulus
-from wheelsoil.taichi_types import vec3
+from wheelsoil.taichi_types import to_ndarray, vec3
 
 WHEEL_STEEL = Material("wheel", youngs_modulus=SEED004_WHEEL.youngs_modulus,
                        poisson_ratio=SEED004_WHEEL.poisson_ratio, density=SEED004_WHEEL.density)
-
-
-def _nd(values, dtype=vec3):
-    arr = ti.ndarray(dtype, shape=len(values))
-    arr.from_numpy(np.ascontiguousarray(values))
-    return arr
 
 
 def test_closest_point_matches_brute_force_and_names_the_region():
@@ -34,8 +28,8 @@ def test_closest_point_matches_brute_force_and_names_the_region():
     n = 400
     a, b, c = rng.normal(size=(3, n, 3))
     p = 1.5 * rng.normal(size=(n, 3))
-    bary, feat = _nd(np.zeros((n, 3))), ti.ndarray(ti.i32, shape=n)
-    closest_points(_nd(p), _nd(a), _nd(b), _nd(c), bary, feat)
+    bary, feat = to_ndarray(vec3, np.zeros((n, 3))), ti.ndarray(ti.i32, shape=n)
+    closest_points(*(to_ndarray(vec3, q) for q in (p, a, b, c)), bary, feat)
     w, f = bary.to_numpy(), feat.to_numpy()
     q = w[:, :1] * a + w[:, 1:2] * b + w[:, 2:] * c
     # brute force over a fine barycentric grid of each triangle

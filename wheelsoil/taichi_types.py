@@ -1,5 +1,7 @@
-"""Taichi vector/matrix types and 1-D/2-D ndarray annotations shared by the solvers' kernels (f64, i32)."""
+"""Taichi vector/matrix types and 1-D/2-D ndarray annotations shared by the solvers' kernels (f64, i32),
+and :func:`to_ndarray` to put a NumPy array on the device."""
 
+import numpy as np
 import taichi as ti
 
 vec3 = ti.types.vector(3, ti.f64)
@@ -22,3 +24,17 @@ nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
 nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
 nd_mat9 = ti.types.ndarray(dtype=mat9, ndim=1)
 nd_mat32 = ti.types.ndarray(dtype=mat32, ndim=1)
+
+
+def to_ndarray(dtype, values) -> ti.Ndarray:
+    """A Taichi ndarray holding ``values`` (element shape taken from ``dtype``).
+
+    Taichi has no empty arrays: an empty ``values`` gives one zero row (kernels are never launched over it).
+    """
+    values = np.ascontiguousarray(values)
+    if values.shape[0] == 0:
+        values = np.zeros((1,) + values.shape[1:], dtype=values.dtype)
+    elem_ndim = getattr(dtype, "ndim", 0)
+    arr = ti.ndarray(dtype=dtype, shape=values.shape[: values.ndim - elem_ndim])
+    arr.from_numpy(values)
+    return arr
