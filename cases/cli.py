@@ -21,14 +21,16 @@ GRAVITY_PRESETS = {"earth": 9.81, "moon": 9.81 / 6.0}
 MAIN_HELP = """\
 wheelsoil: a single-wheel terramechanics testbed in software.
 
-Start with the smoke job (a small regolith bed, settled under Earth gravity, saved to HDF5 and
-rendered to PNG):
+Start with the smoke job: the seed-004 lunar-rover wheel (coarse mesh) driven at slip 0.3 and
+steering angle 10 deg through a small regolith bed under Earth gravity with W = 3000 N (about
+three minutes on two cores, bed preparation included):
 
     wheelsoil run
 
-drive the lunar-rover wheel through a bed (about two minutes on two cores):
+the same wheel at Moon gravity with W = 500 N (equal wheel mass), or other rig settings:
 
-    wheelsoil testbed smoke-1g-steer
+    wheelsoil run smoke-moon-steer
+    wheelsoil run smoke-1g-steer --slip 0.5 --slip-angle 20 --rigid --out runs/rigid
 
 or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
@@ -81,11 +83,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"wheelsoil {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("run", help="run the embedded smoke job (prepare a small bed, save HDF5, render PNG)",
-                       description="Run the embedded smoke job: prepare a small regolith bed under the chosen "
-                                   "gravity (cached), write it to OUT/bed.h5 and render OUT/bed.png offscreen.")
-    _add_bed_options(p)
-    p.add_argument("--out", type=Path, default=Path("wheelsoil-output"), help="output folder (default wheelsoil-output)")
+    p = sub.add_parser("run", aliases=["testbed"],
+                       help="drive a wheel through a prepared bed (single-wheel testbed); default: the smoke job",
+                       description="Run a testbed case: prepare (or reuse) its bed under the case's gravity, lower "
+                                   "the wheel until the soil carries the load W, drive at the commanded slip and "
+                                   "steering angle, detect the steady state and average. Writes series.csv, "
+                                   "summary.json, series.png and a render of the last state (final.png) to --out. "
+                                   "Cases: smoke-1g-steer (the default; about 3 minutes on 2 cores with the bed, "
+                                   "W = 3000 N), smoke-moon-steer (1/6 g, W = 500 N), seed004-1g-steer and "
+                                   "seed004-moon-steer (full scale, hours). 'wheelsoil testbed' is the same command.")
+    p.add_argument("case", nargs="?", default="smoke-1g-steer",
+                   help="case name (smoke-1g-steer [default], smoke-moon-steer, seed004-1g-steer, seed004-moon-steer)")
+    p.add_argument("--slip", type=float, default=None, help="longitudinal slip i in [-1, 1) (default: the case's)")
+    p.add_argument("--slip-angle", type=float, default=None, help="steering angle beta [deg] in (-90, 90)")
+    p.add_argument("--load", type=float, default=None, help="vertical load W [N] > 0, wheel weight included")
+    p.add_argument("--drive-time", type=float, default=None, help="driving time [s]")
+    p.add_argument("--rigid", action="store_true", help="use the rigid wheel with the same surface")
+    p.add_argument("--no-render", action="store_true", help="skip the render of the last state")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case>)")
+    p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin; write it to HDF5",
@@ -133,26 +149,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="largest plate load as a multiple of the preset's nominal load (default 1.5)")
     p.set_defaults(func=cmd_wheel)
 
-    p = sub.add_parser("testbed", help="drive a wheel through a prepared bed (single-wheel testbed)",
-                       description="Run a testbed case: prepare (or reuse) its bed under the case's gravity, lower "
-                                   "the wheel until the soil carries the load W, drive at the commanded slip and "
-                                   "steering angle, detect the steady state and average. Writes series.csv, "
-                                   "summary.json and series.png to --out. Cases: smoke-1g-steer (about 2 minutes "
-                                   "on 2 cores, W = 3000 N), smoke-moon-steer (1/6 g, W = 500 N), seed004-1g-steer "
-                                   "and seed004-moon-steer (full scale, hours).")
-    p.add_argument("case", help="case name (smoke-1g-steer, smoke-moon-steer, seed004-1g-steer, seed004-moon-steer)")
-    p.add_argument("--slip", type=float, default=None, help="longitudinal slip i in [-1, 1) (default: the case's)")
-    p.add_argument("--slip-angle", type=float, default=None, help="steering angle beta [deg] in (-90, 90)")
-    p.add_argument("--load", type=float, default=None, help="vertical load W [N] > 0, wheel weight included")
-    p.add_argument("--drive-time", type=float, default=None, help="driving time [s]")
-    p.add_argument("--rigid", action="store_true", help="use the rigid wheel with the same surface")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case>)")
-    p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
-    p.set_defaults(func=cmd_testbed)
     return parser
 
 
-def cmd_testbed(args) -> int:
+def cmd_run(args) -> int:
     import json
 
     from wheelsoil.coupling.presets import preset_case
@@ -185,13 +185,25 @@ def cmd_testbed(args) -> int:
     with atomic_output(out / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2, default=str))
     _plot_series(result, out / "series.png", case.name)
+    written = [out / "series.csv", out / "summary.json", out / "series.png"]
+    if not args.no_render:
+        from .render import render_testbed
+
+        with atomic_output(out / "final.png") as tmp:
+            image = tmp.with_suffix(".png")  # the renderer picks the format from the suffix
+            try:
+                render_testbed(result, image, title=f"{case.name}: end of the run")
+                image.replace(tmp)
+            finally:
+                image.unlink(missing_ok=True)
+        written.append(out / "final.png")
     s = result.summary
     console.print(("steady state" if s["steady"] else "[yellow]no steady state detected; averaged the last half[/]")
                   + f" over t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s:")
-    for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage"):
+    for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
         console.print(f"  {q:15s} {s[q]['mean']:10.4g} +- {s[q]['std']:.3g} {s[q]['units']}")
     console.print(f"{result.info['wall_seconds']:.0f} s wall for {result.info['simulated_seconds']:.2f} s simulated; "
-                  f"wrote {out / 'series.csv'}, {out / 'summary.json'}, {out / 'series.png'}")
+                  f"wrote {', '.join(str(w) for w in written)}")
     return EXIT_OK
 
 
@@ -211,8 +223,10 @@ def _plot_series(result, path, title):
     axes[0].set_ylabel("force on the wheel [N]")
     axes[1].plot(t, s["torque"], color="C3")
     axes[1].set_ylabel("driving torque [N m]")
-    axes[2].plot(t, 1e3 * s["sinkage"], color="C4")
+    axes[2].plot(t, 1e3 * s["sinkage"], color="C4", label="hub (with deflection)")
+    axes[2].plot(t, 1e3 * s["tread_sinkage"], color="C5", label="tread")
     axes[2].set_ylabel("sinkage [mm]")
+    axes[2].legend(fontsize=8)
     axes[2].set_xlabel("time [s]")
     t0, t1 = result.summary["window"]
     for ax in axes:
@@ -343,18 +357,6 @@ def _prepare(args, console):
     origin = "reused from cache" if bed.meta.get("from_cache") else f"prepared in {bed.meta['prepare_seconds']:.1f} s"
     console.print(f"[bold]{bed.summary()}[/bold] ({origin})")
     return bed
-
-
-def cmd_run(args) -> int:
-    from .render import render_bed
-
-    console = _console()
-    bed = _prepare(args, console)
-    out = Path(args.out)
-    h5 = bed.save(out / "bed.h5")
-    png = render_bed(bed, out / "bed.png")
-    console.print(f"wrote {h5} and {png}")
-    return EXIT_OK
 
 
 def cmd_prepare_bed(args) -> int:

@@ -47,11 +47,13 @@ def render_particles(
     size: tuple[int, int] = (1200, 800),
     sphere_resolution: int = 12,
     title: str | None = None,
+    surface: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Path:
     """Render spheres (coloured by ``scalars``, default height) to a PNG; returns the path.
 
     ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline. ``camera`` is one of
-    :data:`CAMERA_PRESETS`.
+    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a steel-grey
+    triangulated surface (the wheel).
     """
     import pyvista as pv
 
@@ -71,6 +73,11 @@ def render_particles(
     plotter.set_background("white")
     plotter.add_mesh(glyphs, scalars=scalar_name, cmap="viridis", smooth_shading=True,
                      scalar_bar_args={"title": scalar_name, "color": "black"})
+    if surface is not None:
+        nodes, tris = np.asarray(surface[0], float), np.asarray(surface[1], np.int64)
+        faces = np.hstack([np.full((len(tris), 1), 3, np.int64), tris]).ravel()
+        plotter.add_mesh(pv.PolyData(nodes, faces), color="#9aa3ad", smooth_shading=False, show_edges=True,
+                         edge_color="#5b6168", line_width=0.5)
     if box is not None:
         lo, hi = np.asarray(box[0], float), np.asarray(box[1], float)
         plotter.add_mesh(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).outline(), color="black",
@@ -96,3 +103,18 @@ def render_bed(bed, path: str | Path, **kwargs) -> Path:
     return render_particles(
         bed.positions, bed.radii, path, box=((0, 0, 0), (s.length, s.width, bed.surface_height)), **kwargs
     )
+
+
+def render_testbed(result, path: str | Path, **kwargs) -> Path:
+    """Render the end of a testbed run: the wheel over the particles, coloured by speed [m/s].
+
+    ``result`` is a :class:`~wheelsoil.coupling.testbed.TestbedResult`.
+    """
+    p = result.final_particles
+    speed = np.linalg.norm(p["velocity"], axis=1)
+    lo, hi = p["position"].min(axis=0) - p["radius"].max(), p["position"].max(axis=0) + p["radius"].max()
+    hi[2] = max(hi[2], float(result.final_wheel_nodes[:, 2].max()))
+    kwargs.setdefault("title", f"{result.bed_summary.split(':')[0]}; t = {result.info['simulated_seconds']:.2f} s")
+    return render_particles(p["position"], p["radius"], path, scalars=speed, scalar_name="speed [m/s]",
+                            box=(lo, hi), surface=(result.final_wheel_nodes, result.mesh.triangles),
+                            **kwargs)

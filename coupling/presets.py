@@ -50,7 +50,8 @@ def seed004_case(*, slip: float, slip_angle: float, load: float, gravity=EARTH, 
     g = "1g" if abs(gravity[2]) > 5 else "moon"
     spec = TestbedSpec(slip=slip, slip_angle=slip_angle, load=load, angular_velocity=1.0, drive_time=2.5,
                        rigid=rigid)
-    return Case(f"seed004-{g}-W{load:g}-i{slip:g}-b{slip_angle:g}", seed004_bed(gravity), LUNAR_ROVER, spec)
+    name = f"seed004-{g}-W{load:g}-i{slip:g}-b{slip_angle:g}{'-rigid' if rigid else ''}"
+    return Case(name, seed004_bed(gravity), LUNAR_ROVER, spec)
 
 
 def smoke_case(*, slip: float = 0.3, slip_angle: float = 10.0, load: float = 3000.0, gravity=EARTH,
@@ -59,7 +60,8 @@ def smoke_case(*, slip: float = 0.3, slip_angle: float = 10.0, load: float = 300
     g = "1g" if abs(gravity[2]) > 5 else "moon"
     spec = TestbedSpec(slip=slip, slip_angle=slip_angle, load=load, angular_velocity=1.0, drive_time=drive_time,
                        rigid=rigid)
-    return Case(f"smoke-{g}-W{load:g}-i{slip:g}-b{slip_angle:g}", smoke_bed(gravity), SMOKE_WHEEL, spec)
+    name = f"smoke-{g}-W{load:g}-i{slip:g}-b{slip_angle:g}{'-rigid' if rigid else ''}"
+    return Case(name, smoke_bed(gravity), SMOKE_WHEEL, spec)
 
 
 #: Named cases: the two smoke steering runs (1g with W = 3000 N, 1/6 g with W = 500 N: equal wheel mass,
@@ -78,4 +80,10 @@ def preset_case(name: str, **overrides) -> Case:
         case = PRESETS[name]
     except KeyError:
         raise WheelsoilInputError(f"unknown testbed case {name!r}; choose one of {sorted(PRESETS)}") from None
-    return replace(case, testbed=replace(case.testbed, **overrides)) if overrides else case
+    if not overrides:
+        return case
+    tb = replace(case.testbed, **overrides)
+    g = "1g" if abs(case.bed.gravity[2]) > 5 else "moon"
+    scale = name.split("-")[0]
+    rigid = "-rigid" if tb.rigid else ""
+    return replace(case, testbed=tb, name=f"{scale}-{g}-W{tb.load:g}-i{tb.slip:g}-b{tb.slip_angle:g}{rigid}")

@@ -6,8 +6,9 @@ Rig kinematics (architecture conventions; seed 004 eqs. 14--16):
   the wheel is yawed by -beta so that the steering (slip) angle beta lies between heading and travel;
 * prescribed wheel spin omega about the axle; travel speed from the commanded slip,
   v_x = (1 - i) r omega along the heading and v_y = v_x tan(beta) across it (global speed v_x / cos beta);
-* the axle is free vertically under the constant load W: the rig applies W - m g downwards at the hub,
-  so the total load on the soil is W at any gravity (m: wheel mass including the hub).
+* the axle is free vertically under the constant load W: the rig applies W - m g downwards at the hub
+  so the total load on the soil is W at any gravity (m: wheel mass including the hub), and a viscous
+  damper on the vertical slide (``axle_damping``) keeps the wheel's heave from ringing.
 
 Protocol: place the wheel with its lowest point just above the highest sphere beneath it; lower it at
 ``lowering_speed`` until the soil carries the load W, then release the axle (free vertically under W)
@@ -18,8 +19,9 @@ Measured quantities (wheel frame, from the contact resultant, time-averaged over
 drawbar pull DP = F.x (net soil force along the heading), lateral force F.y, vertical force F.z,
 driving torque T = -M.y (the torque the motor supplies against the soil's moment about the axle),
 sinkage = surface height + r - hub height (hub drop below where the undeformed tread touches the
-levelled surface; it includes the wheel's deflection), achieved slip and slip angle from the hub's
-velocity.
+levelled surface; it includes the wheel's deflection), tread sinkage = surface height - lowest point of
+the tread's mid-surface (the depth of the rut the tread presses, without the deflection; grousers reach
+deeper), achieved slip and slip angle from the hub's velocity.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ SERIES_UNITS = {
     "vertical_force": "N",
     "torque": "N m",
     "sinkage": "m",
+    "tread_sinkage": "m",
     "slip": "1",
     "slip_angle": "deg",
     "load": "N",
@@ -58,7 +61,8 @@ SERIES_UNITS = {
     "contacts": "1",
 }
 #: Quantities averaged over the steady state.
-STEADY_QUANTITIES = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "slip", "slip_angle")
+STEADY_QUANTITIES = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage", "slip",
+                     "slip_angle")
 
 
 def _check(key: str, value, ok: bool, allowed: str) -> None:
@@ -84,6 +88,12 @@ class TestbedSpec:
     start_x: initial hub position along the bin [m] (default: one wheel radius plus 0.1 m from the start).
     rigid: use the rigid wheel with the same surface instead of the flexible one.
     damping: mass-proportional structural damping of the flexible wheel [1/s], relative to the hub.
+    axle_damping: viscous damper on the rig's vertical slide [N s/m], acting on the hub's vertical speed
+        once the axle is released (like the damper or heavy carriage of a real rig). It has no mean force
+        in a steady state, so the load on the soil stays W, but it stops the wheel's heave on the soil's
+        stiffness from ringing through the run; its force is updated every sample interval. None: wheel
+        mass / 0.1 s (a free heave decays in 0.1 s; roughly 0.4 of critical damping for the smoke case's
+        heave on the soil); 0: no damper.
     pair: soil--wheel contact properties (default seed 004 Table 1 soil--steel).
     """
 
@@ -103,6 +113,7 @@ class TestbedSpec:
     start_x: float | None = None
     rigid: bool = False
     damping: float = 10.0
+    axle_damping: float | None = None
     pair: PairProperties = field(default_factory=lambda: SOIL_STEEL)
 
     def __post_init__(self) -> None:
@@ -122,6 +133,9 @@ class TestbedSpec:
             _check(key, v, fin(v) and v >= 0.0, f"{key} >= 0")
         _check("spin_up_time", self.spin_up_time, self.spin_up_time < self.drive_time,
                f"spin_up_time < drive_time = {self.drive_time}")
+        if self.axle_damping is not None:
+            _check("axle_damping", self.axle_damping, fin(self.axle_damping) and self.axle_damping >= 0.0,
+                   "axle_damping >= 0 N s/m, or None for wheel mass / 0.1 s")
         if self.start_x is not None:
             _check("start_x", self.start_x, fin(self.start_x) and self.start_x > 0.0, "start_x > 0 m")
         if not isinstance(self.pair, PairProperties):
@@ -253,9 +267,13 @@ class Testbed:
         center[2] = top - nodes[:, 2].min() + gap
         mesh.nodes = nodes + center
         self.mesh = mesh
+        tread = mesh.part_names.index("tread") if "tread" in mesh.part_names else None
+        facets = mesh.triangles if tread is None else mesh.triangles[mesh.part[: len(mesh.triangles)] == tread]
+        self._tread_nodes = np.unique(facets)
         self.structure = Structure(mesh, hub_nodes=hub_nodes, hub_center=center, hub_mass=wheel.hub_mass,
                                    rigid=spec.rigid, damping=spec.damping, gravity=bs.gravity, arch=arch)
         self.wheel_mass = float(self.structure.mass.sum() + wheel.hub_mass)
+        self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / 0.1
         self.heading = self.yaw[:, 0]
         self.axle = self.yaw[:, 1]
 
@@ -278,8 +296,13 @@ class Testbed:
     def _release(self) -> None:
         """Free the axle vertically under the load W (the rig applies W - m g downwards)."""
         self.structure.set_hub_state(velocity=(0.0, 0.0, 0.0))
-        self.structure.drive_hub(free_translation=(False, False, True),
-                                 force=(0.0, 0.0, -(self.spec.load - self.wheel_mass * self.gravity)))
+        self.structure.drive_hub(free_translation=(False, False, True))
+        self._apply_load(0.0)
+
+    def _apply_load(self, vertical_speed: float) -> None:
+        """The rig's force on the released axle: W - m g down, and the damper against the vertical speed."""
+        push = -(self.spec.load - self.wheel_mass * self.gravity) - self.axle_damping * vertical_speed
+        self.structure.drive_hub(force=(0.0, 0.0, push))
 
     def run(self, *, progress: bool = False) -> TestbedResult:
         """Run the protocol (lower, settle, drive); returns the time series and the steady-state summary."""
@@ -306,6 +329,8 @@ class Testbed:
                 if phase == "drive":
                     ramp = min(1.0, (t - t_drive) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
                     self._drive(s.angular_velocity * ramp)
+                if phase != "lower" and self.axle_damping > 0.0:
+                    self._apply_load(float(self.structure.hub_velocity[2]))
                 self.scene.step(self.steps_per_sample)
                 force, moment, _ = self.contact.mean_resultant(reset=True)
                 hub = self.structure.hub_position
@@ -319,6 +344,7 @@ class Testbed:
                     "vertical_force": force[2],
                     "torque": -(moment @ self.axle),
                     "sinkage": surface + self.wheel.radius - hub[2],
+                    "tread_sinkage": surface - float(self.structure.positions()[self._tread_nodes, 2].min()),
                     "slip": 1.0 - vx / (self.wheel.radius * spin) if spin > 0 else 0.0,
                     "slip_angle": math.degrees(math.atan2(vy, vx)) if abs(vx) > 1e-12 else 0.0,
                     "load": s.load if phase != "lower" else 0.0,

@@ -1,4 +1,4 @@
-"""The command line's smoke job and the offscreen render."""
+"""The command line (bed preparation, render, input errors of the testbed run) and the offscreen render."""
 
 import numpy as np
 import pytest
@@ -23,12 +23,24 @@ def test_render_is_non_blank_and_sized(tmp_path):
     assert len(np.unique((rgb * 255).astype(int).reshape(-1, 3), axis=0)) > 50
 
 
-def test_cli_run_writes_bed_and_png(tmp_path, monkeypatch):
+def test_cli_prepare_bed_and_render(tmp_path, monkeypatch):
     monkeypatch.setenv("WHEELSOIL_CACHE", str(tmp_path / "cache"))
-    rc = main(["run", "--length", "0.16", "--width", "0.1", "--depth", "0.06", "--out", str(tmp_path / "out")])
+    bed = tmp_path / "out" / "bed.h5"
+    rc = main(["prepare-bed", "--length", "0.16", "--width", "0.1", "--depth", "0.06", "--out", str(bed)])
     assert rc == EXIT_OK
-    assert (tmp_path / "out" / "bed.h5").stat().st_size > 0
-    assert (tmp_path / "out" / "bed.png").stat().st_size > 0
+    assert bed.stat().st_size > 0
+    assert main(["render", str(bed), "--size", "320", "240"]) == EXIT_OK
+    assert bed.with_suffix(".png").stat().st_size > 0
+
+
+def test_cli_run_rejects_bad_testbed_input(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "--slip", "1.5", "--out", str(out)]) == EXIT_INPUT
+    assert "testbed slip = 1.5 is out of range: allowed -1 <= slip < 1" in capsys.readouterr().err
+    assert main(["testbed", "no-such-case", "--out", str(out)]) == EXIT_INPUT
+    assert "unknown testbed case 'no-such-case'" in capsys.readouterr().err
+    assert main(["run", "smoke-moon-steer", "--load", "0", "--out", str(out)]) == EXIT_INPUT
+    assert not out.exists()
 
 
 def test_cli_bad_input_exit_code(tmp_path, capsys):

@@ -65,6 +65,21 @@ def test_no_particle_inside_the_wheel(steering_run):
     assert np.all(dist > 0.5 * r[near] + surface.half_thickness[facet])
 
 
+def test_render_of_the_last_state_shows_wheel_and_soil(steering_run, tmp_path):
+    import matplotlib.image as mpimg
+
+    from wheelsoil.cases.render import render_testbed
+
+    _, result = steering_run
+    img = mpimg.imread(render_testbed(result, tmp_path / "final.png", size=(320, 240)))[..., :3]
+    assert img.shape[:2] == (240, 320)
+    # steel-grey wheel (equal channels, mid grey) and coloured particles both cover a visible area
+    grey = (np.ptp(img, axis=2) < 0.06) & (img.mean(axis=2) > 0.3) & (img.mean(axis=2) < 0.8)
+    coloured = np.ptp(img, axis=2) > 0.15
+    assert grey.mean() > 0.005
+    assert coloured.mean() > 0.05
+
+
 def test_steady_state_detection_finds_the_plateau():
     t = np.linspace(0, 2, 401)
     rng = np.random.default_rng(0)
@@ -87,6 +102,7 @@ def test_steady_state_detection_finds_the_plateau():
         (dict(load=-10.0), "load"),
         (dict(angular_velocity=0.0), "angular_velocity"),
         (dict(drive_time=float("nan")), "drive_time"),
+        (dict(axle_damping=-1.0), "axle_damping"),
     ],
 )
 def test_bad_rig_settings_name_the_key_value_and_range(change, key):
@@ -103,3 +119,22 @@ def test_wheel_wider_than_the_bin_short_bin_and_missing_bed_are_refused(mini_bed
         Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, drive_time=5.0))
     with pytest.raises(WheelsoilInputError, match="does not exist"):
         Testbed(tmp_path / "missing.h5", MINI_WHEEL, MINI_RUN)
+
+
+def _mean_and_error(result, name, blocks=4):
+    """Steady mean and its standard error from block means (the series is correlated in time)."""
+    t0 = result.summary["window"][0]
+    y = result.series[name][result.series["t"] >= t0]
+    means = np.array([b.mean() for b in np.array_split(y, blocks)])
+    return means.mean(), means.std(ddof=1) / np.sqrt(blocks)
+
+
+@pytest.mark.slow
+def test_drawbar_pull_and_torque_rise_with_slip(mini_bed):
+    """Straight driving at slip 0.1 and 0.6: more slip mobilises more shear, so DP and torque rise
+    (seed 004 Figs. 7--8; Wong--Reece/Janosi shear grows with slip). The difference must exceed three
+    combined standard errors of the steady means."""
+    runs = {i: Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, slip=i, slip_angle=0.0)).run() for i in (0.1, 0.6)}
+    for q in ("drawbar_pull", "torque"):
+        (lo, e_lo), (hi, e_hi) = (_mean_and_error(runs[i], q) for i in (0.1, 0.6))
+        assert hi - lo > 3.0 * np.hypot(e_lo, e_hi), (q, lo, e_lo, hi, e_hi)

@@ -1,0 +1,262 @@
+"""Coupled testbed speed: wall time per simulated second at smoke scale, where each DEM step's time goes,
+and a measured extrapolation to seed-004 scale (388,026 particles, the full-resolution wheel).
+
+1. Smoke scale (``smoke-1g-steer``: about 12,000 particles, 3,456 wheel elements): runs the whole testbed
+   protocol (lower, settle, drive) and reports wall time per simulated second and peak memory; then keeps
+   driving for ``--steps`` DEM steps with timers on the three parts of a coupled step -- the soil (DEM
+   neighbour search, contact forces, integration), the wheel (its FE sub-steps over the DEM step) and the
+   wheel--soil contact (evaluation, and candidate rebuilds separately).
+2. Seed-004 scale, each part measured in its own process so that its memory is its own:
+   * the wheel at the preset's full resolution: mesh, stable step, time per FE sub-step, memory;
+   * a bed of 388,026 spheres of 16--24 mm (``dem_throughput.memory_check``): memory while stepping;
+   * the bare interpreter with Taichi initialised (subtracted from both, so the sum counts it once).
+3. Extrapolation: the soil's cost per particle-step, the contact cost per contact and the rebuild cost per
+   particle, all measured in part 1, times the seed-004 counts; the wheel's measured sub-step time times
+   the sub-steps per (smaller) seed-004 DEM step; the seed-004 protocol's simulated time (lowering as
+   measured at smoke scale, then 0.1 s settle, 0.05 s spin-up, 2.5 s drive).
+
+Run:  python -m wheelsoil.benchmarks.testbed_throughput [--out benchmarks/results/testbed.json] [--arch cuda]
+"""
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from wheelsoil import runtime
+from wheelsoil.benchmarks.common import machine, peak_rss_mib, versions
+
+SEED004_PARTICLES = 388_026
+SEED004_DRIVE_TIME = 2.5
+
+
+def own_peak_rss_mib() -> float:
+    """Peak resident memory of this process's own address space [MiB] (``VmHWM``).
+
+    ``getrusage``'s maximum survives fork and exec, so a child started by a large parent would report at
+    least the parent's size; the high-water mark of the address space does not.
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return peak_rss_mib()
+
+
+def _timed(obj, name: str, totals: dict, key: str) -> None:
+    """Replace ``obj.name`` by a wrapper that adds its wall time to ``totals[key]``."""
+    inner = getattr(obj, name)
+
+    def wrapper(*args, **kwargs):
+        t0 = time.perf_counter()
+        try:
+            return inner(*args, **kwargs)
+        finally:
+            totals[key] += time.perf_counter() - t0
+
+    setattr(obj, name, wrapper)
+
+
+def smoke_part(steps: int, drive_time: float, arch) -> dict:
+    from wheelsoil.coupling.presets import preset_case
+    from wheelsoil.coupling.testbed import Testbed
+    from wheelsoil.granular import prepare_bed
+
+    case = preset_case("smoke-1g-steer", drive_time=drive_time)
+    bed = prepare_bed(case.bed, arch=arch)
+    t0 = time.perf_counter()
+    bench = Testbed(bed, case.wheel, case.testbed, arch=arch)
+    setup = time.perf_counter() - t0
+    result = bench.run()
+    info = result.info
+    out = {
+        "case": case.name,
+        "particles": info["particles"],
+        "fe_elements": info["fe_elements"],
+        "contact_facets": info["contact_facets"],
+        "setup_seconds": setup,
+        "protocol_wall_seconds": info["wall_seconds"],
+        "protocol_simulated_seconds": info["simulated_seconds"],
+        "wall_seconds_per_simulated_second": info["seconds_per_simulated_second"],
+        "lowering_and_settling_simulated_seconds": info["t_drive_start"],
+        "dem_time_step_s": info["dem_time_step"],
+        "fe_time_step_s": info["fe_time_step"],
+        "fe_substeps_per_dem_step": info["fe_substeps"] / info["dem_steps"],
+    }
+    # where the time of one coupled step goes, in steady driving
+    c, scene = bench.contact, bench.scene
+    totals = {"wheel": 0.0, "contact": 0.0, "rebuild": 0.0}
+    _timed(c, "after_drift", totals, "wheel")
+    _timed(c, "add_forces", totals, "contact")
+    _timed(c, "_rebuild", totals, "rebuild")
+    rebuilds0, dem_rebuilds0 = c.rebuilds, scene.neighbor_rebuilds
+    contacts = 0
+    t0, cpu0 = time.perf_counter(), time.process_time()
+    for _ in range(steps // 10):
+        scene.step(10)
+        contacts += c.contact_count
+    total = time.perf_counter() - t0
+    cpu = time.process_time() - cpu0
+    n = 10 * (steps // 10)
+    contact_eval = totals["contact"] - totals["rebuild"]
+    out.update({
+        "timed_steps": n,
+        "ms_per_step": 1e3 * total / n,
+        "cores_busy": cpu / total,  # CPU time of all threads / wall time over the timed steps
+        "ms_per_step_soil": 1e3 * (total - totals["wheel"] - totals["contact"]) / n,
+        "ms_per_step_wheel": 1e3 * totals["wheel"] / n,
+        "ms_per_step_contact_evaluation": 1e3 * contact_eval / n,
+        "ms_per_step_contact_rebuild": 1e3 * totals["rebuild"] / n,
+        "contact_rebuilds": c.rebuilds - rebuilds0,
+        "dem_neighbor_rebuilds": scene.neighbor_rebuilds - dem_rebuilds0,
+        "mean_wheel_contacts": contacts / (steps // 10),
+        "peak_rss_mib": own_peak_rss_mib(),
+    })
+    return out
+
+
+def fe_seed004_part(steps: int, arch) -> dict:
+    from wheelsoil.coupling.surface import ContactSurface
+    from wheelsoil.flexwheel.geometry import LUNAR_ROVER, build_wheel_mesh
+    from wheelsoil.flexwheel.structure import Structure
+
+    runtime.init(arch)
+    mesh, hub = build_wheel_mesh(LUNAR_ROVER)
+    wheel = Structure(mesh, hub_nodes=hub, hub_center=mesh.nodes[hub].mean(axis=0), hub_mass=LUNAR_ROVER.hub_mass,
+                      damping=10.0, gravity=(0.0, 0.0, -9.81))
+    surface = ContactSurface.from_mesh(mesh)
+    wheel.step(10)
+    best = math.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        wheel.step(steps)
+        best = min(best, (time.perf_counter() - t0) / steps)
+    return {"fe_elements": int(mesh.n_elements), "nodes": int(mesh.n_nodes), "contact_facets": int(surface.n_facets),
+            "fe_time_step_s": wheel.stable_time_step, "ms_per_substep": 1e3 * best, "peak_rss_mib": own_peak_rss_mib()}
+
+
+def dem_seed004_part(arch) -> dict:
+    from wheelsoil.benchmarks.dem_throughput import memory_check
+
+    runtime.init(arch)
+    return memory_check(SEED004_PARTICLES) | {"peak_rss_mib": own_peak_rss_mib()}
+
+
+def base_part(arch) -> dict:
+    import taichi as ti
+
+    runtime.init(arch)
+
+    @ti.kernel
+    def touch() -> ti.i32:
+        return 1
+
+    touch()
+    return {"peak_rss_mib": own_peak_rss_mib()}
+
+
+def _child(part: str, arch, steps: int) -> dict:
+    cmd = [sys.executable, "-m", "wheelsoil.benchmarks.testbed_throughput", "--part", part, "--steps", str(steps)]
+    if arch:
+        cmd += ["--arch", arch]
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"benchmark part {part!r} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
+    """Seed-004 cost from the measured smoke-scale parts and the measured full-resolution wheel."""
+    from wheelsoil.coupling.presets import seed004_bed, smoke_bed
+
+    s_bed, f_bed = smoke_bed(), seed004_bed()
+    # the DEM step scales with the smallest radius (Rayleigh and Hertz estimates are both ~ R)
+    dt = smoke["dem_time_step_s"] * f_bed.diameter_min / s_bed.diameter_min
+    particles = SEED004_PARTICLES / smoke["particles"]
+    # contacts on the same tread area scale with 1 / d^2
+    d_s = 0.5 * (s_bed.diameter_min + s_bed.diameter_max)
+    d_f = 0.5 * (f_bed.diameter_min + f_bed.diameter_max)
+    contacts = (d_s / d_f) ** 2
+    substeps = math.ceil(dt / fe["fe_time_step_s"])
+    ms = {
+        "soil": smoke["ms_per_step_soil"] * particles,
+        "wheel": fe["ms_per_substep"] * substeps,
+        "contact_evaluation": smoke["ms_per_step_contact_evaluation"] * contacts,
+        # candidate rebuilds loop over all particles; they follow the DEM rebuilds (every ~skin / speed)
+        "contact_rebuild": smoke["ms_per_step_contact_rebuild"] * particles,
+    }
+    simulated = smoke["lowering_and_settling_simulated_seconds"] + 0.05 + SEED004_DRIVE_TIME
+    per_step = sum(ms.values())
+    steps = simulated / dt
+    return {
+        "particles": SEED004_PARTICLES,
+        "fe_elements": fe["fe_elements"],
+        "contact_facets": fe["contact_facets"],
+        "dem_time_step_s": dt,
+        "fe_substeps_per_dem_step": substeps,
+        "scale_factors": {"particles": particles, "contacts": contacts},
+        "ms_per_step": ms | {"total": per_step},
+        "wall_seconds_per_simulated_second": per_step * 1e-3 / dt,
+        "protocol_simulated_seconds": simulated,
+        "protocol_wall_hours": per_step * 1e-3 * steps / 3600.0,
+        "peak_rss_mib": dem["peak_rss_mib"] + fe["peak_rss_mib"] - base["peak_rss_mib"],
+        "peak_rss_parts_mib": {"soil_388k": dem["peak_rss_mib"], "wheel_full": fe["peak_rss_mib"],
+                               "interpreter_and_taichi": base["peak_rss_mib"]},
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", type=Path, default=Path("benchmarks/results/testbed.json"))
+    ap.add_argument("--steps", type=int, default=600, help="DEM steps timed in steady driving (default 600)")
+    ap.add_argument("--drive-time", type=float, default=0.3, help="smoke protocol drive time [s] (default 0.3)")
+    ap.add_argument("--arch", default=None, help="Taichi backend (default cpu)")
+    ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base"), help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.part:
+        fn = {"fe-seed004": lambda: fe_seed004_part(min(args.steps, 200), args.arch),
+              "dem-seed004": lambda: dem_seed004_part(args.arch), "base": lambda: base_part(args.arch)}[args.part]
+        print(json.dumps(fn()))
+        return 0
+    runtime.init(args.arch)
+    report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
+    print("smoke scale: whole protocol, then timed steady driving ...", flush=True)
+    smoke = report["smoke"] = smoke_part(args.steps, args.drive_time, args.arch)
+    print(f"  {smoke['particles']} particles, {smoke['fe_elements']} elements: "
+          f"{smoke['wall_seconds_per_simulated_second']:.1f} s wall per simulated s over the protocol "
+          f"({smoke['protocol_wall_seconds']:.0f} s for {smoke['protocol_simulated_seconds']:.2f} s); per DEM step "
+          f"{smoke['ms_per_step']:.2f} ms = soil {smoke['ms_per_step_soil']:.2f} + wheel {smoke['ms_per_step_wheel']:.2f}"
+          f" ({smoke['fe_substeps_per_dem_step']:.0f} sub-steps) + contact {smoke['ms_per_step_contact_evaluation']:.2f}"
+          f" + rebuild {smoke['ms_per_step_contact_rebuild']:.2f}; {smoke['cores_busy']:.2f} cores busy; "
+          f"peak RSS {smoke['peak_rss_mib']:.0f} MiB", flush=True)
+    print("seed-004 scale parts (own processes) ...", flush=True)
+    fe = report["seed004_wheel"] = _child("fe-seed004", args.arch, args.steps)
+    print(f"  wheel {fe['fe_elements']} elements, {fe['contact_facets']} contact facets: "
+          f"{fe['ms_per_substep']:.2f} ms per sub-step of {fe['fe_time_step_s']:.3g} s; RSS {fe['peak_rss_mib']:.0f} MiB",
+          flush=True)
+    dem = report["seed004_soil"] = _child("dem-seed004", args.arch, args.steps)
+    base = report["base"] = _child("base", args.arch, args.steps)
+    print(f"  soil {dem['particles']} spheres: RSS {dem['peak_rss_mib']:.0f} MiB; interpreter + Taichi "
+          f"{base['peak_rss_mib']:.0f} MiB", flush=True)
+    ext = report["seed004_extrapolated"] = extrapolate(smoke, fe, dem, base)
+    ms = ext["ms_per_step"]
+    print(f"seed-004 scale (extrapolated): DEM step {ext['dem_time_step_s']:.3g} s, {ext['fe_substeps_per_dem_step']} "
+          f"wheel sub-steps; per step {ms['total']:.0f} ms = soil {ms['soil']:.0f} + wheel {ms['wheel']:.0f} + contact "
+          f"{ms['contact_evaluation']:.1f} + rebuild {ms['contact_rebuild']:.1f}; "
+          f"{ext['wall_seconds_per_simulated_second'] / 3600:.2f} h wall per simulated s; one case "
+          f"({ext['protocol_simulated_seconds']:.2f} s simulated) {ext['protocol_wall_hours']:.1f} h; "
+          f"peak RSS {ext['peak_rss_mib']:.0f} MiB", flush=True)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(report, indent=2, default=float))
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,301 @@
+"""Trends of the coupled wheel--soil runs at smoke scale (issue 4), written to docs/coupling-trends.md.
+
+Runs the smoke testbed (lunar-rover wheel r = 0.6 m, b = 0.5 m, coarse mesh; 2.0 x 0.9 x 0.2 m bed of
+25--37.5 mm particles) at the conditions below, each with ``wheelsoil testbed`` in its own process, then
+plots what seed 004 (and seed 001 for the rigid wheel) report:
+
+* drawbar pull and sinkage against slip (straight driving, 1g, W = 3000 N);
+* drawbar pull and lateral force against steering angle (slip 0.3);
+* 1g with W = 3000 N against 1/6 g with W = 500 N (equal wheel mass): differences in sinkage, drawbar pull
+  and lateral force beside seed 004's 12.35 %, 76.60 % and 83.23 %;
+* flexible against rigid wheel of the same surface: the drawbar-pull ratio (seed 001: about 2x).
+
+Usage (from the repository root; about 20 minutes on 2 CPU cores, finished runs are reused)::
+
+    python docs/coupling_trends.py                 # run what is missing, write figures and the report
+    python docs/coupling_trends.py --report-only   # rebuild figures and report from finished runs
+
+Runs go to ``wheelsoil-output/trends/<run>/`` (series.csv, summary.json, series.png).
+"""
+
+import argparse
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent
+#: Seed 004 abstract: mean differences between 1g/W = 3000 N and 1/6 g/W = 500 N.
+SEED004_GRAVITY_DIFFERENCE = {"sinkage": 12.35, "drawbar_pull": 76.60, "lateral_force": 83.23}
+
+#: name -> (preset, overrides); every run at angular velocity 1 rad/s (r omega = 0.6 m/s).
+RUNS = {
+    "1g-W3000-i0.1-b0": ("smoke-1g-steer", {"slip": 0.1, "slip_angle": 0.0}),
+    "1g-W3000-i0.3-b0": ("smoke-1g-steer", {"slip": 0.3, "slip_angle": 0.0}),
+    "1g-W3000-i0.5-b0": ("smoke-1g-steer", {"slip": 0.5, "slip_angle": 0.0}),
+    "1g-W3000-i0.3-b10": ("smoke-1g-steer", {"slip": 0.3, "slip_angle": 10.0}),
+    "1g-W3000-i0.3-b20": ("smoke-1g-steer", {"slip": 0.3, "slip_angle": 20.0}),
+    "moon-W500-i0.3-b10": ("smoke-moon-steer", {"slip": 0.3, "slip_angle": 10.0}),
+    "1g-W3000-i0.3-b0-rigid": ("smoke-1g-steer", {"slip": 0.3, "slip_angle": 0.0, "rigid": True}),
+}
+QUANTITIES = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage")
+
+
+def run_case(name: str, preset: str, overrides: dict, drive_time: float, runs: Path) -> Path:
+    """Run one case with the command line unless a finished run with the same settings exists."""
+    out = runs / name
+    summary = out / "summary.json"
+    if summary.exists():
+        tb = json.loads(summary.read_text())["testbed"]
+        wanted = dict(overrides, drive_time=drive_time)
+        if all(tb.get(k) == v for k, v in wanted.items()):
+            print(f"[{name}] reusing {summary}")
+            return out
+    cmd = [sys.executable, "-m", "wheelsoil.cases.cli", "testbed", preset, "--slip", str(overrides["slip"]),
+           "--slip-angle", str(overrides["slip_angle"]), "--drive-time", str(drive_time), "--out", str(out)]
+    if overrides.get("rigid"):
+        cmd.append("--rigid")
+    print(f"[{name}] {' '.join(cmd[1:])}", flush=True)
+    subprocess.run(cmd, check=True)
+    return out
+
+
+def batch_mean_error(values: np.ndarray, blocks: int = 4) -> float:
+    """Standard error of a correlated series' mean from the scatter of ``blocks`` consecutive block means."""
+    means = np.array([b.mean() for b in np.array_split(values, blocks)])
+    return float(means.std(ddof=1) / np.sqrt(blocks))
+
+
+def load_run(path: Path) -> dict:
+    """Steady means, standard deviations and batch-means errors of one finished run."""
+    meta = json.loads((path / "summary.json").read_text())
+    with open(path / "series.csv") as fh:
+        rows = list(csv.reader(fh))
+    header = [h.split("[")[0] for h in rows[0]]
+    data = np.array(rows[1:], dtype=float)
+    series = {h: data[:, k] for k, h in enumerate(header)}
+    t0, t1 = meta["summary"]["window"]
+    sel = (series["t"] >= t0) & (series["t"] <= t1)
+    out = {"meta": meta, "window": (t0, t1), "steady": meta["summary"]["steady"], "series": series}
+    for q in QUANTITIES:
+        v = series[q][sel]
+        out[q] = (float(v.mean()), float(v.std()), batch_mean_error(v))
+    return out
+
+
+def difference(a: float, b: float) -> float:
+    """Relative change of the magnitude, (|b| - |a|) / |a| in per cent (a the 1g value)."""
+    return 100.0 * (abs(b) - abs(a)) / abs(a)
+
+
+def make_figures(res: dict, figures: Path) -> dict:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figures.mkdir(parents=True, exist_ok=True)
+    found = {}
+
+    def errbar(ax, x, names, q, scale=1.0, **kw):
+        m = [scale * res[n][q][0] for n in names]
+        e = [abs(scale) * res[n][q][2] for n in names]
+        ax.errorbar(x, m, yerr=e, marker="o", capsize=3, **kw)
+        return m
+
+    slips = ["1g-W3000-i0.1-b0", "1g-W3000-i0.3-b0", "1g-W3000-i0.5-b0"]
+    if all(n in res for n in slips):
+        x = [res[n]["meta"]["testbed"]["slip"] for n in slips]
+        fig, (a0, a1) = plt.subplots(1, 2, figsize=(9, 3.6))
+        dp = errbar(a0, x, slips, "drawbar_pull", color="C0")
+        a0.set_xlabel("slip i")
+        a0.set_ylabel("drawbar pull [N]")
+        a0.axhline(0, color="0.6", lw=0.7)
+        errbar(a1, x, slips, "sinkage", scale=1e3, color="C4", label="hub (with the wheel's deflection)")
+        errbar(a1, x, slips, "tread_sinkage", scale=1e3, color="C5", label="tread")
+        a1.legend(fontsize=8)
+        a1.set_xlabel("slip i")
+        a1.set_ylabel("sinkage [mm]")
+        fig.suptitle("Straight driving, 1g, W = 3000 N (smoke scale)")
+        fig.tight_layout()
+        fig.savefig(figures / "dp_vs_slip.png", dpi=110)
+        plt.close(fig)
+        found["dp_vs_slip"] = dict(zip(x, dp))
+
+    betas = ["1g-W3000-i0.3-b0", "1g-W3000-i0.3-b10", "1g-W3000-i0.3-b20"]
+    if all(n in res for n in betas):
+        x = [res[n]["meta"]["testbed"]["slip_angle"] for n in betas]
+        fig, ax = plt.subplots(figsize=(5.5, 3.8))
+        dp = errbar(ax, x, betas, "drawbar_pull", color="C0", label="drawbar pull")
+        fy = errbar(ax, x, betas, "lateral_force", scale=-1.0, color="C1", label="lateral force (-F_y)")
+        ax.set_xlabel("steering angle beta [deg]")
+        ax.set_ylabel("force on the wheel [N]")
+        ax.axhline(0, color="0.6", lw=0.7)
+        ax.legend()
+        ax.set_title("Slip 0.3, 1g, W = 3000 N (smoke scale)")
+        fig.tight_layout()
+        fig.savefig(figures / "dp_fy_vs_steering.png", dpi=110)
+        plt.close(fig)
+        found["dp_vs_beta"] = dict(zip(x, dp))
+        found["minus_fy_vs_beta"] = dict(zip(x, fy))
+
+    pair = ["1g-W3000-i0.3-b10", "moon-W500-i0.3-b10"]
+    if all(n in res for n in pair):
+        qs = ("sinkage", "tread_sinkage", "drawbar_pull", "lateral_force")
+        ours = {q: difference(res[pair[0]][q][0], res[pair[1]][q][0]) for q in qs}
+        seed = dict(SEED004_GRAVITY_DIFFERENCE, tread_sinkage=SEED004_GRAVITY_DIFFERENCE["sinkage"])
+        fig, ax = plt.subplots(figsize=(7, 3.8))
+        xs = np.arange(len(qs))
+        ax.bar(xs - 0.2, [abs(ours[q]) for q in qs], 0.4, label="wheelsoil (smoke scale, i 0.3, beta 10 deg)")
+        ax.bar(xs + 0.2, [seed[q] for q in qs], 0.4, label="seed 004 (mean over conditions; one sinkage figure)")
+        ax.set_xticks(xs, ["sinkage (hub)", "tread sinkage", "drawbar pull", "lateral force"])
+        ax.set_ylabel("|difference| 1g/3000 N vs 1/6 g/500 N [%]")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(figures / "gravity_difference.png", dpi=110)
+        plt.close(fig)
+        found["gravity_difference_percent"] = ours
+
+    flex = ["1g-W3000-i0.3-b0", "1g-W3000-i0.3-b0-rigid"]
+    if all(n in res for n in flex):
+        f, r = (res[n]["drawbar_pull"] for n in flex)
+        ratio = f[0] / r[0]
+        ratio_err = abs(ratio) * np.hypot(f[2] / f[0], r[2] / r[0])
+        fig, ax = plt.subplots(figsize=(4.5, 3.6))
+        ax.bar([0, 1], [f[0], r[0]], yerr=[f[2], r[2]], capsize=4, color=["C0", "C7"])
+        ax.set_xticks([0, 1], ["flexible", "rigid"])
+        ax.set_ylabel("drawbar pull [N]")
+        ax.set_title(f"i 0.3, beta 0, 1g, W 3000 N: ratio {ratio:.2f}")
+        fig.tight_layout()
+        fig.savefig(figures / "flexible_vs_rigid.png", dpi=110)
+        plt.close(fig)
+        found["flexible_over_rigid_dp"] = (float(ratio), float(ratio_err))
+    return found
+
+
+def write_report(res: dict, found: dict, path: Path, drive_time: float) -> None:
+    lines = [
+        "# Coupled wheel–soil trends at smoke scale",
+        "",
+        "Generated by `python docs/coupling_trends.py` (every number and figure below comes from the runs it",
+        f"makes; drive time {drive_time:g} s after lowering, settling and spin-up). Smoke scale: the seed-004",
+        "lunar-rover wheel (r = 0.6 m, b = 0.5 m, 188 kg) on a coarse mesh (3,456 elements) and a",
+        "2.0 × 0.9 × 0.2 m bed of 25–37.5 mm particles (≈ 12,000), ω = 1 rad/s. Particles are about 1.5×",
+        "seed 004's and the bed half as deep, so forces are those of a coarser soil; the trends, not the",
+        "magnitudes, are what this scale can show. Errors are standard errors of the steady-state mean",
+        "(four block means); ± in the table is the standard deviation of the fluctuating force.",
+        "",
+        "Sinkage is the hub's drop below where the undeformed tread touches the surface, so it includes the",
+        "wheel's deflection; tread sinkage is the depth of the lowest point of the tread below the surface.",
+        "",
+        "| run | steady | window [s] | DP [N] | F_y [N] | F_z [N] | torque [N m] | sinkage [mm] | tread sinkage [mm] "
+        "| wall [s] |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name, r in res.items():
+        cells = [f"{r[q][0]:.0f} ± {r[q][1]:.0f}" for q in QUANTITIES[:4]]
+        cells += [f"{1e3 * r[q][0]:.1f} ± {1e3 * r[q][1]:.1f}" for q in ("sinkage", "tread_sinkage")]
+        lines.append(f"| {name} | {'yes' if r['steady'] else 'no'} | {r['window'][0]:.2f}–{r['window'][1]:.2f} | "
+                     + " | ".join(cells) + f" | {r['meta']['run']['wall_seconds']:.0f} |")
+    lines.append("")
+    if "dp_vs_slip" in found:
+        lines += ["## Drawbar pull rises with slip", "", "![](figures/dp_vs_slip.png)", "",
+                  "DP at slip " + ", ".join(f"{k:g}: {v:.0f} N" for k, v in found["dp_vs_slip"].items()) + ".", ""]
+    if "dp_vs_beta" in found:
+        lines += ["## Steering: drawbar pull falls, lateral force rises", "", "![](figures/dp_fy_vs_steering.png)",
+                  "", "DP at β " + ", ".join(f"{k:g}°: {v:.0f} N" for k, v in found["dp_vs_beta"].items())
+                  + "; −F_y " + ", ".join(f"{k:g}°: {v:.0f} N" for k, v in found["minus_fy_vs_beta"].items()) + ".",
+                  ""]
+    if "gravity_difference_percent" in found:
+        d = found["gravity_difference_percent"]
+        lines += ["## Equal wheel mass at 1g and 1/6 g", "", "![](figures/gravity_difference.png)", "",
+                  "Change at 1/6 g with W = 500 N relative to 1g with W = 3000 N (seed 004 gives the magnitude of",
+                  "the difference, averaged over slips and steering angles):", "",
+                  "| quantity | wheelsoil (i 0.3, β 10°) | seed 004 (mean magnitude) |", "|---|---|---|"]
+        lines += [f"| {q.replace('_', ' ')} | {d[q]:+.1f} % | "
+                  f"{SEED004_GRAVITY_DIFFERENCE.get(q, SEED004_GRAVITY_DIFFERENCE['sinkage']):.2f} % |" for q in d]
+        lines.append("")
+    if "flexible_over_rigid_dp" in found:
+        ratio, err = found["flexible_over_rigid_dp"]
+        lines += ["## Flexible against rigid wheel", "", "![](figures/flexible_vs_rigid.png)", "",
+                  f"Drawbar-pull ratio flexible/rigid at i 0.3, β 0°: {ratio:.2f} ± {err:.2f} (seed 001: about 2).",
+                  ""]
+    lines += reading(res, found)
+    path.write_text("\n".join(lines))
+    (path.with_suffix(".json")).write_text(json.dumps(
+        {"drive_time": drive_time, "found": {k: ({str(a): b for a, b in v.items()} if isinstance(v, dict) else v)
+                                             for k, v in found.items()},
+         "runs": {n: {q: r[q] for q in QUANTITIES} | {"steady": r["steady"], "window": r["window"],
+                                                     "wall_seconds": r["meta"]["run"]["wall_seconds"]}
+                  for n, r in res.items()}}, indent=1))
+
+
+def reading(res: dict, found: dict) -> list[str]:
+    """What the figures show beside the papers, with the numbers of these runs."""
+    out = ["## Reading", ""]
+    unsteady = [n for n, r in res.items() if not r["steady"]]
+    if unsteady:
+        out += [f"* Runs without a detected steady state ({', '.join(unsteady)}) are averaged over the last half "
+                "of the drive; their forces still drift or swing by more than the detector's 15 % within 1 s of "
+                "driving, which the 2 m smoke bin cannot extend at low slip.", ""]
+    if "dp_vs_slip" in found:
+        dp = list(found["dp_vs_slip"].values())
+        ts = [1e3 * res[n]["tread_sinkage"][0] for n in ("1g-W3000-i0.1-b0", "1g-W3000-i0.3-b0", "1g-W3000-i0.5-b0")]
+        out += [f"* **Slip.** Drawbar pull rises monotonically ({dp[0]:.0f} → {dp[-1]:.0f} N from i = 0.1 to 0.5) and "
+                f"the tread sinks deeper ({ts[0]:.1f} → {ts[-1]:.1f} mm), as in seed 004 (Figs. 6–7).", ""]
+    if "dp_vs_beta" in found:
+        dp = list(found["dp_vs_beta"].values())
+        fy = list(found["minus_fy_vs_beta"].values())
+        out += [f"* **Steering.** From β = 0 to 20° drawbar pull falls by {100 * (1 - dp[-1] / dp[0]):.0f} % and the "
+                f"lateral force grows from {fy[0]:.0f} to {fy[-1]:.0f} N (seed 004 at 1g, 3000 N: drawbar pull "
+                "−36.9 % on average from 5 to 20°, lateral force +301 %).", ""]
+    if "gravity_difference_percent" in found:
+        d = found["gravity_difference_percent"]
+        g1, gm = res["1g-W3000-i0.3-b10"], res["moon-W500-i0.3-b10"]
+        defl = [1e3 * (r["sinkage"][0] - r["tread_sinkage"][0]) for r in (g1, gm)]
+        out += [f"* **Gravity at equal wheel mass.** Drawbar pull ({d['drawbar_pull']:+.0f} %) and lateral force "
+                f"({d['lateral_force']:+.0f} %) drop as strongly as seed 004 reports (76.6 %, 83.2 %). The tread "
+                f"sinkage changes by {d['tread_sinkage']:+.0f} %, close to seed 004's 12 % (its largest differences "
+                f"reach 25 %). The hub's drop ({d['sinkage']:+.0f} %) is dominated by the wheel's own deflection, "
+                f"{defl[0]:.0f} mm under 3000 N against {defl[1]:.0f} mm under 500 N. Seed 004 does not say which it "
+                "measures.", ""]
+    if "flexible_over_rigid_dp" in found:
+        ratio, err = found["flexible_over_rigid_dp"]
+        f, r = res["1g-W3000-i0.3-b0"], res["1g-W3000-i0.3-b0-rigid"]
+        out += [f"* **Flexible against rigid.** The flexible wheel pulls {ratio:.2f} ± {err:.2f} times the rigid one, "
+                f"not seed 001's 2×, although its tread sinks far less ({1e3 * f['tread_sinkage'][0]:.0f} against "
+                f"{1e3 * r['tread_sinkage'][0]:.0f} mm). Seed 001's factor is for loosely packed soil modelled as a "
+                "continuum (Drucker–Prager cap), where the rigid wheel's extra sinkage costs compaction resistance. "
+                "Here the bed is dense (packing fraction 0.59) and coarse: a 25–37.5 mm particle is as large as the "
+                "grousers, so the larger contact patch adds little shear. This gap is open; the full-scale "
+                "particle size would test it.", ""]
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--runs", type=Path, default=Path("wheelsoil-output/trends"), help="run folder")
+    p.add_argument("--drive-time", type=float, default=1.0, help="drive time of every run [s] (default 1.0)")
+    p.add_argument("--only", nargs="*", default=None, help="run only these names")
+    p.add_argument("--report-only", action="store_true", help="do not run; report what is finished")
+    args = p.parse_args(argv)
+    names = args.only or list(RUNS)
+    unknown = sorted(set(names) - set(RUNS))
+    if unknown:
+        p.error(f"unknown runs {unknown}; choose from {list(RUNS)}")
+    if not args.report_only:
+        for name in names:
+            preset, overrides = RUNS[name]
+            run_case(name, preset, overrides, args.drive_time, args.runs)
+    res = {n: load_run(args.runs / n) for n in RUNS if (args.runs / n / "summary.json").exists()}
+    found = make_figures(res, ROOT / "figures")
+    write_report(res, found, ROOT / "coupling-trends.md", args.drive_time)
+    print(json.dumps(found, indent=1, default=float))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
