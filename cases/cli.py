@@ -149,7 +149,38 @@ def build_parser() -> argparse.ArgumentParser:
                    help="largest plate load as a multiple of the preset's nominal load (default 1.5)")
     p.set_defaults(func=cmd_wheel)
 
+    p = sub.add_parser("validate", help="hold the semi-empirical model against measured data; name what it misses",
+                       description="Calibrate the classical wheel-soil model (Wong-Reece, Janosi-Hanamoto, lateral "
+                                   "shear) on training conditions, diagnose its residuals, fit every candidate "
+                                   "mechanism the data can show (slip-sinkage, theta_m moving with slip, soil flow, "
+                                   "sidewall, grousers, surrogate radius, gravity-scaled cohesion), rank them by "
+                                   "held-out error and BIC, and write report.md, findings.json and plots to "
+                                   "--report. DATA: a folder of CMU trial files, the digitised single-wheel CSV, a "
+                                   "CSV in wheelsoil's format (slip, vertical_load_N, wheel_radius_m, "
+                                   "wheel_width_m, drawbar_pull_N, ...), or 'synthetic' (a hidden mechanism, "
+                                   "revealed at the end of the report).")
+    p.add_argument("data", help="measured data (folder or CSV), or 'synthetic'")
+    p.add_argument("--model", choices=["semi-empirical"], default="semi-empirical",
+                   help="model to hold against the data (default semi-empirical)")
+    p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")
+    p.add_argument("--holdout", default=None,
+                   help="CONDITION=VALUE: hold out one level, e.g. slip_angle=45 or group=smooth "
+                        "(default: a random 30 %% of the conditions)")
+    p.add_argument("--responses", nargs="+", default=None,
+                   help="responses to fit: drawbar_pull lateral_force sinkage torque (default: those measured)")
+    p.add_argument("--hidden", default=None, help="synthetic only: mechanism to hide, or 'none' (default: random)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the hold-out split and synthetic data")
+    p.add_argument("--group", default=None,
+                   help="keep the rows whose group starts with this (e.g. ding2011: one rig and soil of the "
+                        "digitised set; grouser or smooth in the CMU set)")
+    p.set_defaults(func=cmd_validate)
     return parser
+
+
+def cmd_validate(args) -> int:
+    from wheelsoil.validation.workflow import main_validate
+
+    return main_validate(args)
 
 
 def cmd_run(args) -> int:
@@ -406,6 +437,7 @@ class _InputError(ValueError):
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_INPUT

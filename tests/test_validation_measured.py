@@ -1,0 +1,69 @@
+"""Measured-data loading: units from column names, the two shared datasets, clear errors for bad files."""
+
+import csv
+import os
+
+import numpy as np
+import pytest
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.validation.measured import load_cmu_trials, load_digitised, load_table, split_unit
+
+
+def _raw(path, column):
+    with open(path, newline="") as fh:
+        return np.array([float(r[column]) for r in csv.DictReader(fh)])
+
+
+@pytest.mark.parametrize("column, expected", [
+    ("drawbar_pull_N", ("drawbar_pull", "N", 1.0)),
+    ("sinkage_mm", ("sinkage", "m", 1e-3)),
+    ("rim_speed_mm_s", ("rim_speed", "m/s", 1e-3)),
+    ("meas_torque_nm", ("meas_torque", "N m", 1.0)),
+    ("steering_angle_deg", ("steering_angle", "deg", 1.0)),
+    ("slip", ("slip", None, 1.0)),
+])
+def test_units_come_from_the_column_suffix(column, expected):
+    assert split_unit(column) == expected
+
+
+def test_cmu_trials_in_si(measured_dir):
+    folder = os.path.join(measured_dir, "cmu_3d_terramechanics")
+    everything = load_cmu_trials(folder, driving_only=False)
+    driving = load_cmu_trials(folder)
+    raw_sinkage = np.concatenate([_raw(os.path.join(folder, f"{w}_wheel_trials.csv"), "sinkage_mm")
+                                  for w in ("grouser", "smooth")])
+    np.testing.assert_allclose(everything.responses["sinkage"], raw_sinkage * 1e-3)
+    assert len(everything) == len(raw_sinkage)
+    assert 0 < len(driving) < len(everything)
+    assert np.all((driving.slip >= 0) & (driving.slip < 1))
+    assert set(np.unique(driving.group)) == {"grouser", "smooth"}
+    assert set(np.unique(driving.slip_angle)) >= {0.0, 30.0, 60.0, 90.0}
+    assert np.all(driving.load > 0) and np.all(driving.radius == 0.058)
+
+
+def test_digitised_points_in_si(measured_dir):
+    path = os.path.join(measured_dir, "digitised_single_wheel", "single_wheel_experiments.csv")
+    data = load_digitised(path)
+    np.testing.assert_allclose(data.responses["drawbar_pull"], _raw(path, "meas_drawbar_pull_n"))
+    np.testing.assert_allclose(data.radius, _raw(path, "wheel_radius_m"))
+    assert len(data) == len(_raw(path, "slip"))
+    assert {g.split(":")[1] for g in data.group} == {"lug", "smooth"}
+
+
+def test_bad_files_name_the_problem(tmp_path):
+    with pytest.raises(WheelsoilInputError, match="does not exist"):
+        load_table(tmp_path / "none.csv")
+    ragged = tmp_path / "ragged.csv"
+    ragged.write_text("slip,drawbar_pull_N\n0.1,3\n0.2\n")
+    with pytest.raises(WheelsoilInputError, match="line 3: 1 fields, the header has 2"):
+        load_table(ragged)
+    text = tmp_path / "text.csv"
+    text.write_text("slip,drawbar_pull_N\n0.1,three\n")
+    with pytest.raises(WheelsoilInputError, match="'drawbar_pull_N' has unit N but holds 'three'"):
+        load_table(text)
+    missing = tmp_path / "grouser_wheel_trials.csv"
+    missing.write_text("slip,drawbar_pull_N\n0.1,3\n")
+    (tmp_path / "smooth_wheel_trials.csv").write_text("slip,drawbar_pull_N\n0.1,3\n")
+    with pytest.raises(WheelsoilInputError, match=r"missing column\(s\) \['steering_angle'"):
+        load_cmu_trials(tmp_path)

@@ -1,0 +1,168 @@
+"""The semi-empirical wheel--soil model against closed forms, published factors and exact similarities."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.validation.terramechanics import (
+    RigidWheel,
+    SoilParameters,
+    bearing_capacity_factors,
+    contact_forces,
+    predict,
+    sidewall_force,
+)
+
+WHEEL = RigidWheel(radius=0.15, width=0.15)
+SAND = SoilParameters()  # seed 003 Table III, unit 1 (dry sand)
+
+
+def _linear_soil(**kw):
+    """n = 1, theta_m = 0 (no rear region), cohesionless: stress integrals have closed forms."""
+    base = dict(cohesion=0.0, n0=1.0, n1=0.0, a1=0.0, a2=0.0, c3=0.0, kc_prime=0.0)
+    return replace(SAND, **(base | kw))
+
+
+def _closed_form_integrals(theta_f):
+    c, s = np.cos(theta_f), np.sin(theta_f)
+    a = theta_f / 2 + np.sin(2 * theta_f) / 4 - c * s  # int_0^tf (cos t - cos tf) cos t dt
+    b = (1 - c) ** 2 / 2  # int_0^tf (cos t - cos tf) sin t dt
+    t = s - theta_f * c  # int_0^tf (cos t - cos tf) dt
+    return a, b, t
+
+
+@pytest.mark.parametrize("sinkage", [0.005, 0.02, 0.06])
+def test_pure_compaction_matches_the_closed_form(sinkage):
+    """No shear (huge k_x): F_z = r b K A and DP = -r b K B, the compaction resistance (n = 1)."""
+    soil = _linear_soil(shear_modulus_x=1e9)
+    g = 9.81
+    out = contact_forces(soil, WHEEL, sinkage, 0.0, 0.0, g)
+    r, b = WHEEL.radius, WHEEL.width
+    k = soil.density * g * b * soil.kphi_prime * (r / b)
+    a, bb, _ = _closed_form_integrals(np.arccos(1 - sinkage / r))
+    assert out["vertical_force"][0] == pytest.approx(r * b * k * a, rel=1e-9)
+    assert out["drawbar_pull"][0] == pytest.approx(-r * b * k * bb, rel=1e-6)
+
+
+def test_fully_mobilised_shear_matches_the_closed_form():
+    """At slip near 1 and a tiny k_x the shear is sigma tan(phi) everywhere (Mohr--Coulomb, c = 0)."""
+    soil = _linear_soil(shear_modulus_x=1e-9)
+    z, g = 0.03, 9.81
+    out = contact_forces(soil, WHEEL, z, 0.999, 0.0, g)
+    r, b = WHEEL.radius, WHEEL.width
+    k = soil.density * g * b * soil.kphi_prime * (r / b)
+    mu = np.tan(np.radians(soil.friction_angle))
+    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    assert out["drawbar_pull"][0] == pytest.approx(r * b * k * (mu * a - bb), rel=1e-6)
+    assert out["vertical_force"][0] == pytest.approx(r * b * k * (mu * bb + a), rel=1e-6)
+    assert out["torque"][0] == pytest.approx(r * r * b * k * mu * t, rel=1e-6)
+
+
+def test_quadrature_matches_adaptive_integration_with_a_rear_region():
+    """Default sand (n = 1.1, theta_m = (a1 + a2 i) theta_f, rebound c3): Gauss--Legendre vs scipy quad."""
+    soil = replace(SAND, c3=0.2)
+    z, i, g = 0.02, 0.3, 9.81
+    r, b = WHEEL.radius, WHEEL.width
+    out = contact_forces(soil, WHEEL, z, i, 0.0, g)
+    tf = np.arccos(1 - z / r)
+    tm, tr = (soil.a1 + soil.a2 * i) * tf, -soil.c3 * tf
+    n = soil.n0
+    k = (soil.cohesion * soil.kc_prime + soil.density * g * b * soil.kphi_prime) * (r / b) ** n
+
+    def sigma(t):
+        eq = t if t >= tm else tf - (t - tr) / (tm - tr) * (tf - tm)
+        return k * max(np.cos(eq) - np.cos(tf), 0.0) ** n
+
+    def tau(t):
+        j = r * (tf - t - (1 - i) * (np.sin(tf) - np.sin(t)))
+        return (soil.cohesion + sigma(t) * np.tan(np.radians(soil.friction_angle))) * (1 - np.exp(-j / soil.shear_modulus_x))
+
+    fz = r * b * sum(quad(lambda t: tau(t) * np.sin(t) + sigma(t) * np.cos(t), lo, hi, epsabs=0, epsrel=1e-11)[0]
+                     for lo, hi in ((tr, tm), (tm, tf)))
+    fx = r * b * sum(quad(lambda t: tau(t) * np.cos(t) - sigma(t) * np.sin(t), lo, hi, epsabs=0, epsrel=1e-11)[0]
+                     for lo, hi in ((tr, tm), (tm, tf)))
+    assert out["vertical_force"][0] == pytest.approx(fz, rel=1e-7)
+    assert out["drawbar_pull"][0] == pytest.approx(fx, rel=1e-6)
+
+
+def test_terzaghi_factors_match_the_published_table():
+    """Coduto (2001) modified Terzaghi factors at phi = 30 deg: N_c = 37.2, N_q = 22.5, N_gamma = 19.7."""
+    n_gamma, n_c, n_q = bearing_capacity_factors(30.0)
+    assert n_c == pytest.approx(37.2, abs=0.1)
+    assert n_q == pytest.approx(22.5, abs=0.1)
+    assert n_gamma == pytest.approx(19.7, abs=0.5)
+
+
+def test_sidewall_force_matches_direct_integration():
+    z, beta, g = 0.03, np.radians(20.0), 9.81
+    r = WHEEL.radius
+    n_gamma, n_c, _ = bearing_capacity_factors(SAND.friction_angle)
+    tf = np.arccos(1 - z / r)
+
+    def integrand(x):
+        f = np.sqrt(r * r - x * x) - r * np.cos(tf)
+        return (SAND.density * g * n_gamma * f + SAND.cohesion * n_c) * f
+
+    expected = np.sin(beta) * quad(integrand, -r * np.sin(tf), r * np.sin(tf), epsrel=1e-11)[0]
+    assert sidewall_force(SAND, WHEEL, np.array([z]), beta, np.array([g]))[0] == pytest.approx(expected, rel=1e-8)
+
+
+def test_sinkage_solves_vertical_equilibrium():
+    slip = np.linspace(-0.5, 0.8, 7)
+    out = predict(SAND, WHEEL, slip=slip, slip_angle=10.0, load=120.0)
+    assert out["supported"].all()
+    np.testing.assert_allclose(out["vertical_force"], 120.0, rtol=1e-9)
+
+
+def test_cohesionless_soil_at_equal_mass_sinks_the_same_at_any_gravity():
+    """Reece's pressure ~ rho g and Mohr--Coulomb strength ~ sigma when c = 0: with W ~ g the sinkage is
+    gravity independent and every force scales with g (the similarity behind seed 004's finding)."""
+    soil = replace(SAND, cohesion=0.0, kc_prime=0.0)
+    wheel = replace(WHEEL, grouser_height=0.01, grouser_count=12)
+    earth = predict(soil, wheel, slip=0.3, slip_angle=10.0, load=120.0, gravity=9.81)
+    moon = predict(soil, wheel, slip=0.3, slip_angle=10.0, load=120.0 / 6.0, gravity=9.81 / 6.0)
+    assert moon["sinkage"] == pytest.approx(earth["sinkage"], rel=1e-9)
+    for q in ("drawbar_pull", "lateral_force", "torque"):
+        assert moon[q] == pytest.approx(earth[q] / 6.0, rel=1e-8)
+    # with cohesion the strength no longer scales with g: the Moon wheel sinks less
+    cohesive = predict(SAND, wheel, slip=0.3, load=[120.0, 20.0], gravity=[9.81, 9.81 / 6.0])
+    assert cohesive["sinkage"][1] < 0.9 * cohesive["sinkage"][0]
+
+
+def test_trends_and_symmetry():
+    slips = np.linspace(0.0, 0.8, 9)
+    dp = predict(SAND, WHEEL, slip=slips, load=100.0)["drawbar_pull"]
+    assert np.all(np.diff(dp) > 0)  # drawbar pull rises with slip
+    betas = np.array([-20.0, -10.0, 0.0, 10.0, 20.0])
+    out = predict(SAND, WHEEL, slip=0.2, slip_angle=betas, load=100.0)
+    fy = out["lateral_force"]
+    assert fy[2] == 0.0
+    np.testing.assert_allclose(fy[::-1], -fy, rtol=1e-12)
+    assert fy[3] < 0 and fy[4] < fy[3]  # opposes the lateral slip and grows with beta
+    grouser = predict(SAND, replace(WHEEL, grouser_height=0.01, grouser_count=15), slip=0.2, load=100.0)
+    assert grouser["drawbar_pull"] > out["drawbar_pull"][2]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(slip=1.0, load=50.0), r"slip\[0\] = 1.0 is out of range"),
+    (dict(slip=0.2, slip_angle=90.0, load=50.0), r"slip_angle\[0\] = 90.0"),
+    (dict(slip=[0.1, 0.2], load=[50.0, -1.0]), r"load\[1\] = -1.0 is out of range: allowed load > 0 N"),
+    (dict(slip=0.2, load=50.0, gravity=float("nan")), r"gravity\[0\] = nan"),
+])
+def test_bad_conditions_name_the_value(kwargs, match):
+    with pytest.raises(WheelsoilInputError, match=match):
+        predict(SAND, WHEEL, **kwargs)
+
+
+def test_bad_parameters_name_the_key():
+    with pytest.raises(WheelsoilInputError, match="friction_angle = 75"):
+        SoilParameters(friction_angle=75.0)
+    with pytest.raises(WheelsoilInputError, match="density = -1"):
+        SoilParameters(density=-1.0)
+    with pytest.raises(WheelsoilInputError, match="theta_m outside"):
+        SoilParameters(a1=0.8, a2=0.5)
+    with pytest.raises(WheelsoilInputError, match="grouser_height"):
+        RigidWheel(radius=0.1, width=0.1, grouser_height=0.2)

@@ -1,0 +1,1 @@
+"""Validation: measured data and the semi-empirical terramechanics model (``terramechanics``)."""

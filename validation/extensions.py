@@ -1,0 +1,135 @@
+"""Named physical mechanisms that extend the classical wheel--soil model, each with its parameters.
+
+The classical model (:data:`BASELINE`) is Wong--Reece normal stress with Reece's gravity-explicit pressure
+and a constant theta_m / theta_f ratio, Janosi--Hanamoto shear along and across the wheel, and sinkage from
+vertical equilibrium (:mod:`wheelsoil.validation.terramechanics`). Its calibrated parameters are
+:data:`BASELINE_FREE`; every other mechanism is switched off (:data:`BASELINE_OFF`).
+
+An :class:`Extension` switches one mechanism on and frees its parameters. Each names the equation it comes
+from (seeds 000 and 003 in ``../shared/seeds``) and says which data can reveal it (``applies``): a
+mechanism that acts only under steering, on grousers or when gravity changes cannot be found in data
+without those.
+"""
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A free model parameter: a field of :class:`~wheelsoil.validation.terramechanics.SoilParameters`,
+    its bounds and, for positive scale parameters, a log transform for the fit."""
+
+    name: str
+    lower: float
+    upper: float
+    log: bool = False
+    unit: str = "-"
+
+    def to_fit(self, value: float) -> float:
+        return float(np.log(value)) if self.log else float(value)
+
+    def from_fit(self, x: float) -> float:
+        return float(np.exp(x)) if self.log else float(x)
+
+    @property
+    def fit_bounds(self) -> tuple[float, float]:
+        return (self.to_fit(self.lower), self.to_fit(self.upper))
+
+
+@dataclass(frozen=True)
+class Extension:
+    """One mechanism: its name, what it is, the equation it implements, its parameters and their values
+    when it is off, and a test of whether a dataset can show it."""
+
+    name: str
+    mechanism: str
+    source: str
+    parameters: tuple[Parameter, ...]
+    off: dict
+    applies: Callable
+
+
+#: Parameters the classical model is calibrated on (the shear moduli are tied, k_y = k_x, as in Artemis).
+BASELINE_FREE = (
+    Parameter("kphi_prime", 10.0, 1e5, log=True),
+    Parameter("cohesion", 0.0, 2e4, unit="Pa"),
+    Parameter("friction_angle", 15.0, 50.0, unit="deg"),
+    Parameter("shear_modulus_x", 5e-4, 0.2, log=True, unit="m"),
+    Parameter("n0", 0.3, 2.0),
+    Parameter("a1", 0.05, 0.6),
+)
+
+#: The classical model: every extension off.
+BASELINE_OFF = {
+    "n1": 0.0,
+    "a2": 0.0,
+    "soil_flow": 0.0,
+    "sidewall_scale": 0.0,
+    "grouser_scale": 0.0,
+    "radius_scale": 1.0,
+    "grouser_tip_fraction": 0.0,
+    "cohesion_gravity_exponent": 0.0,
+}
+
+
+def _varies(values, tol: float = 1e-9) -> bool:
+    values = np.asarray(values, float)
+    return values.size > 1 and float(np.nanmax(values) - np.nanmin(values)) > tol
+
+
+EXTENSIONS = {
+    e.name: e
+    for e in (
+        Extension(
+            "slip_sinkage", "sinkage exponent rising with slip: the wheel digs in as it slips",
+            "seed 003 eq. 5, seed 000 eq. 4: n = n0 + n1 |i|",
+            (Parameter("n1", -0.3, 1.5),), {"n1": 0.0},
+            lambda d: _varies(d.slip),
+        ),
+        Extension(
+            "theta_m_slip", "angle of maximum normal stress moving forward with slip",
+            "seed 003 eq. 8 (Oida; Wong--Reece): theta_m = (a1 + a2 i) theta_f",
+            (Parameter("a2", -0.3, 0.6),), {"a2": 0.0},
+            lambda d: _varies(d.slip),
+        ),
+        Extension(
+            "soil_flow", "soil under the rim carried along with it, reducing the shear displacement",
+            "seed 000 eq. 8: j = r((theta_f - theta)(1 - v_soil / (r omega)) - (1 - i)(sin theta_f - sin theta))",
+            (Parameter("soil_flow", 0.0, 0.9),), {"soil_flow": 0.0},
+            lambda d: _varies(d.slip),
+        ),
+        Extension(
+            "sidewall", "passive soil resistance on the wheel's sidewall when it slides sideways",
+            "seed 003 eqs. 17--19 (Schwanghart; modified Terzaghi factors)",
+            (Parameter("sidewall_scale", 0.0, 10.0),), {"sidewall_scale": 0.0},
+            lambda d: bool(np.any(np.abs(d.slip_angle) > 0)) and np.isfinite(d.responses["lateral_force"]).any(),
+        ),
+        Extension(
+            "grouser", "passive earth pressure on the grousers in the soil",
+            "seed 003 eq. 20 (Wong 2001)",
+            (Parameter("grouser_scale", 0.0, 10.0),), {"grouser_scale": 0.0},
+            lambda d: bool(np.any((d.grouser_height > 0) & (d.grouser_count > 0))),
+        ),
+        Extension(
+            "grouser_tip_radius", "soil trapped between grousers: the shearing surface at the grouser tips",
+            "lugged-wheel idealisation (Wong, Theory of Ground Vehicles): radius r + lambda h",
+            (Parameter("grouser_tip_fraction", 0.0, 1.5),), {"grouser_tip_fraction": 0.0},
+            lambda d: bool(np.any(d.grouser_height > 0)),
+        ),
+        Extension(
+            "surrogate_radius", "flexible wheel flattening: a larger effective radius in the contact",
+            "seed 000 sec. 4 (effective radius R > r, Table 3; eq. 19 without the periodic part)",
+            (Parameter("radius_scale", 1.0, 2.0),), {"radius_scale": 1.0},
+            lambda d: True,
+        ),
+        Extension(
+            "gravity_cohesion", "soil strength that falls with gravity (cohesion ~ g^kappa)",
+            "seed 000 sec. 5: measured soil strength is lower at reduced gravity",
+            (Parameter("cohesion_gravity_exponent", -1.0, 3.0),), {"cohesion_gravity_exponent": 0.0},
+            lambda d: _varies(d.gravity),
+        ),
+    )
+}

@@ -1,0 +1,257 @@
+"""Measured single-wheel data: CSV files whose column names carry their units, read into SI NumPy arrays.
+
+A column named ``<quantity>_<unit>`` (``drawbar_pull_N``, ``sinkage_mm``, ``rim_speed_mm_s``,
+``vertical_load_n``, ``meas_torque_nm``) is converted to SI by its unit suffix (:data:`UNITS`); angles stay
+in degrees (``_deg``), as in case files and reports. Columns without a known unit (``wheel``, ``slip``,
+``trial``, ``source``) are kept as they are: numbers as floats, the rest as strings.
+
+:func:`load_table` reads any such file; :func:`load_cmu_trials` and :func:`load_digitised` turn the two
+datasets in ``../shared/data/measured`` into :class:`Measurements` with the standard names the model uses
+(slip, slip_angle [deg], load [N], drawbar_pull, lateral_force, sinkage, torque and their standard
+deviations where measured) and the wheel of every row.
+"""
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+
+#: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
+UNITS = {
+    "_m_s2": ("m/s^2", 1.0),
+    "_mm_s": ("m/s", 1e-3),
+    "_m_s": ("m/s", 1.0),
+    "_kg_m3": ("kg/m^3", 1.0),
+    "_nm": ("N m", 1.0),
+    "_Nm": ("N m", 1.0),
+    "_mm": ("m", 1e-3),
+    "_m": ("m", 1.0),
+    "_N": ("N", 1.0),
+    "_n": ("N", 1.0),
+    "_kPa": ("Pa", 1e3),
+    "_Pa": ("Pa", 1.0),
+    "_deg": ("deg", 1.0),
+    "_s": ("s", 1.0),
+    "_kg": ("kg", 1.0),
+}
+
+
+def split_unit(column: str) -> tuple[str, str | None, float]:
+    """(quantity name, SI unit or None, factor to SI) of a column name."""
+    for suffix in sorted(UNITS, key=len, reverse=True):
+        if column.endswith(suffix) and len(column) > len(suffix):
+            unit, factor = UNITS[suffix]
+            return column[: -len(suffix)], unit, factor
+    return column, None, 1.0
+
+
+@dataclass
+class Table:
+    """Columns of one measured file: ``columns[name]`` is a float array in SI (or a string array)."""
+
+    path: Path
+    columns: dict[str, np.ndarray]
+    units: dict[str, str | None]
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values()))) if self.columns else 0
+
+    def require(self, *names: str) -> None:
+        missing = [n for n in names if n not in self.columns]
+        if missing:
+            raise WheelsoilInputError(
+                f"{self.path}: missing column(s) {missing}; it has {sorted(self.columns)} (units from the name "
+                f"suffix, e.g. drawbar_pull_N, sinkage_mm)")
+
+
+def load_table(path: str | Path) -> Table:
+    """Read a CSV file with units in its column names (see the module docstring)."""
+    path = Path(path)
+    if not path.is_file():
+        raise WheelsoilInputError(f"measured data file {str(path)!r} does not exist")
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if len(rows) < 2:
+        raise WheelsoilInputError(f"{path}: needs a header row and at least one data row")
+    header, body = rows[0], rows[1:]
+    for k, row in enumerate(body, start=2):
+        if len(row) != len(header):
+            raise WheelsoilInputError(f"{path}, line {k}: {len(row)} fields, the header has {len(header)}")
+    columns, units = {}, {}
+    for j, raw in enumerate(header):
+        name, unit, factor = split_unit(raw.strip())
+        values = [row[j].strip() for row in body]
+        try:
+            numbers = np.array([float(v) if v != "" else np.nan for v in values])
+        except ValueError:
+            if unit is not None:
+                bad = next(v for v in values if not _is_float(v))
+                raise WheelsoilInputError(f"{path}: column {raw!r} has unit {unit} but holds {bad!r}") from None
+            columns[name], units[name] = np.array(values), None
+            continue
+        columns[name], units[name] = numbers * factor, unit
+    return Table(path, columns, units)
+
+
+def _is_float(v: str) -> bool:
+    try:
+        float(v)
+    except ValueError:
+        return False
+    return True
+
+
+@dataclass
+class Measurements:
+    """Steady-state single-wheel measurements, one row per test (SI; slip_angle in degrees).
+
+    Conditions: slip, slip_angle, load, gravity, and the wheel of each row (radius, width, grouser_height,
+    grouser_count) plus a ``group`` label (e.g. wheel type or source). Responses: ``responses[name]``
+    for drawbar_pull, lateral_force, sinkage, torque (NaN where not measured) and ``std[name]`` where the
+    data give a standard deviation.
+    """
+
+    name: str
+    slip: np.ndarray
+    slip_angle: np.ndarray
+    load: np.ndarray
+    gravity: np.ndarray
+    radius: np.ndarray
+    width: np.ndarray
+    grouser_height: np.ndarray
+    grouser_count: np.ndarray
+    group: np.ndarray
+    responses: dict[str, np.ndarray]
+    std: dict[str, np.ndarray] = field(default_factory=dict)
+    notes: str = ""
+
+    def __len__(self) -> int:
+        return len(self.slip)
+
+    def select(self, mask) -> "Measurements":
+        mask = np.asarray(mask)
+        pick = lambda a: a[mask]  # noqa: E731
+        return Measurements(self.name, *(pick(getattr(self, k)) for k in (
+            "slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")),
+            responses={k: pick(v) for k, v in self.responses.items()}, std={k: pick(v) for k, v in self.std.items()},
+            notes=self.notes)
+
+
+#: CMU K10-mini wheel (robomechanics/3d-terramechanics parameter files, see the dataset README).
+CMU_WHEEL = {"radius": 0.058, "width": 0.05, "grouser_height": {"grouser": 0.005, "smooth": 0.0}}
+
+
+def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
+    """The CMU 3D-terramechanics trials (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv``).
+
+    The soil carries ``vertical_load``; sinkage is kept as recorded (the lab's zero is the wheel's start
+    position, not the soil surface, so only its changes are comparable). ``driving_only`` keeps rows with
+    0 <= slip < 1 (the model's driving branch); dragged-wheel rows (slip -1) and braking rows are dropped.
+    The grouser count is not in the files: 0 for both (grousers enter through their height only where a
+    model asks for it).
+
+    Lateral force: the lab's sign is positive for a positive steering angle, i.e. it points along the
+    lateral slip's resistance as the lab defines it. In wheelsoil's frame (v_y = v_x tan beta) the soil
+    resists the lateral slip with a force of the opposite sign to beta, so the loader flips the lab's sign.
+    """
+    folder = Path(folder)
+    parts = []
+    for wheel in ("grouser", "smooth"):
+        t = load_table(folder / f"{wheel}_wheel_trials.csv")
+        t.require("steering_angle", "slip", "drawbar_pull", "lateral_force", "vertical_load", "sinkage")
+        parts.append((wheel, t))
+    cols = lambda key: np.concatenate([t.columns[key] for _, t in parts])  # noqa: E731
+    group = np.concatenate([np.full(len(t), w) for w, t in parts])
+    n = len(group)
+    data = Measurements(
+        name="cmu_3d_terramechanics",
+        slip=cols("slip"), slip_angle=cols("steering_angle"), load=cols("vertical_load"),
+        gravity=np.full(n, 9.81), radius=np.full(n, CMU_WHEEL["radius"]), width=np.full(n, CMU_WHEEL["width"]),
+        grouser_height=np.array([CMU_WHEEL["grouser_height"][g] for g in group]), grouser_count=np.zeros(n),
+        group=group,
+        responses={"drawbar_pull": cols("drawbar_pull"), "lateral_force": -cols("lateral_force"),
+                   "sinkage": cols("sinkage"), "torque": np.full(n, np.nan)},
+        std={"drawbar_pull": cols("drawbar_pull_std"), "lateral_force": cols("lateral_force_std"),
+             "vertical_load": cols("vertical_load_std")},
+        notes="Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position",
+    )
+    if driving_only:
+        data = data.select((data.slip >= 0.0) & (data.slip < 1.0))
+    return data
+
+
+def load_digitised(path: str | Path) -> Measurements:
+    """The digitised single-wheel points (Ding 2011, Wang & Han 2016, Hurrell 2025), one row per point."""
+    t = load_table(path)
+    t.require("source", "wheel_radius", "wheel_width", "grouser_height", "grouser_count", "vertical_load", "slip",
+              "meas_drawbar_pull", "meas_sinkage", "meas_torque")
+    n = len(t)
+    return Measurements(
+        name="digitised_single_wheel",
+        slip=t.columns["slip"], slip_angle=np.zeros(n), load=t.columns["vertical_load"], gravity=np.full(n, 9.81),
+        radius=t.columns["wheel_radius"], width=t.columns["wheel_width"],
+        grouser_height=t.columns["grouser_height"], grouser_count=t.columns["grouser_count"],
+        group=np.array([f"{s}:{'lug' if h > 0 else 'smooth'}" for s, h in zip(t.columns["source"],
+                                                                               t.columns["grouser_height"])]),
+        responses={"drawbar_pull": t.columns["meas_drawbar_pull"], "sinkage": t.columns["meas_sinkage"],
+                   "torque": t.columns["meas_torque"], "lateral_force": np.full(n, np.nan)},
+        notes="values read off published figures (approximate); cite the original papers",
+    )
+
+
+#: Columns of wheelsoil's own measurement format (:func:`save_measurements`, :func:`load_generic`).
+GENERIC_COLUMNS = {
+    "slip": "slip", "slip_angle": "slip_angle_deg", "load": "vertical_load_N", "gravity": "gravity_m_s2",
+    "radius": "wheel_radius_m", "width": "wheel_width_m", "grouser_height": "grouser_height_m",
+    "grouser_count": "grouser_count", "drawbar_pull": "drawbar_pull_N", "lateral_force": "lateral_force_N",
+    "sinkage": "sinkage_m", "torque": "torque_Nm",
+}
+
+
+def save_measurements(data: Measurements, path: str | Path) -> Path:
+    """Write measurements in wheelsoil's CSV format (units in the column names; readable by
+    :func:`load_generic` and by any spreadsheet)."""
+    from wheelsoil.provenance import atomic_output
+
+    cols = {GENERIC_COLUMNS[k]: getattr(data, k) for k in ("slip", "slip_angle", "load", "gravity", "radius", "width",
+                                                           "grouser_height", "grouser_count")}
+    cols |= {GENERIC_COLUMNS[q]: data.responses[q] for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")}
+    cols["group"] = data.group
+    rows = [",".join(cols)] + [",".join(str(v[k]) if isinstance(v[k], str) else f"{float(v[k]):.10g}"
+                                        for v in cols.values()) for k in range(len(data))]
+    with atomic_output(path) as tmp:
+        tmp.write_text("\n".join(rows) + "\n")
+    return Path(path)
+
+
+def load_generic(path: str | Path, name: str | None = None) -> Measurements:
+    """Measurements in wheelsoil's CSV format (see :data:`GENERIC_COLUMNS`; slip, load, wheel radius and width
+    required; slip angle 0, gravity 9.81, smooth wheel and missing responses (NaN) by default)."""
+    t = load_table(path)
+    t.require("slip", "vertical_load", "wheel_radius", "wheel_width")
+    n = len(t)
+    get = lambda key, default: t.columns.get(key, np.full(n, default))  # noqa: E731
+    return Measurements(
+        name=name or Path(path).stem, slip=t.columns["slip"], slip_angle=get("slip_angle", 0.0),
+        load=t.columns["vertical_load"], gravity=get("gravity", 9.81), radius=t.columns["wheel_radius"],
+        width=t.columns["wheel_width"], grouser_height=get("grouser_height", 0.0), grouser_count=get("grouser_count", 0.0),
+        group=t.columns["group"] if "group" in t.columns else np.full(n, "all"),
+        responses={q: get(q, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
+        notes=f"read from {path}",
+    )
+
+
+def load_measurements(path: str | Path) -> Measurements:
+    """Any supported dataset: a folder of CMU trial files, the digitised-points CSV, or wheelsoil's format."""
+    path = Path(path)
+    if path.is_dir():
+        if (path / "grouser_wheel_trials.csv").is_file():
+            return load_cmu_trials(path)
+        raise WheelsoilInputError(f"{path} is a folder without grouser_wheel_trials.csv / smooth_wheel_trials.csv")
+    header = load_table(path).columns
+    if "meas_drawbar_pull" in header:
+        return load_digitised(path)
+    return load_generic(path)

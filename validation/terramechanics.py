@@ -1,0 +1,325 @@
+"""Semi-empirical 3-D wheel--soil model: Wong--Reece stresses, Janosi--Hanamoto shear, lateral shear for a
+slip angle, sidewall and grouser forces, sinkage from vertical equilibrium (vectorised NumPy).
+
+Angles theta are measured at the wheel centre from the downward vertical, positive towards the front
+(soil entry at theta_f, exit at theta_r <= 0). Conventions as the rest of wheelsoil (architecture): wheel
+frame x along the heading, y along the axle, z up; slip i = 1 - v_x / (r omega) (driving, i >= 0) and the
+braking branch of seed 003 eq. 4; slip angle beta between heading and travel, v_y = v_x tan(beta). Forces
+are those the soil exerts on the wheel: drawbar pull along +x, lateral force along y, vertical force up,
+driving torque the motor supplies. SI units; ``slip_angle`` in degrees.
+
+Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et al., gravity):
+
+* normal stress, Reece's gravity-explicit pressure--sinkage in Wong--Reece form (seed 003 eq. 7)::
+
+      sigma(theta) = (c k'_c + rho g b k'_phi) (r / b)^n (cos theta - cos theta_f)^n         theta_m <= theta <= theta_f
+      sigma(theta) = same with theta -> theta_f - (theta - theta_r) / (theta_m - theta_r) (theta_f - theta_m)
+                                                                                            theta_r <= theta <= theta_m
+  with n = n0 + n1 |i| (slip-sinkage, seed 003 eq. 5; n1 = 0 gives the classical constant exponent);
+* angle of maximum stress theta_m = (a1 + a2 i) theta_f (seed 003 eq. 8), exit angle theta_r = -c3 theta_f;
+* shear, Janosi--Hanamoto with Mohr--Coulomb strength (seed 003 eqs. 9--10, 13)::
+
+      tau_x = (c + sigma tan phi)(1 - exp(-j_x / k_x)),   tau_y = (c + sigma tan phi)(1 - exp(-j_y / k_y))
+  with the shear displacements of seed 003 eqs. 12 and 16;
+* force integrals (seed 000 eqs. 9--11 in 3-D form, Ishigami et al. 2007)::
+
+      F_x = r b  int (tau_x cos theta - sigma sin theta) d theta
+      F_z = r b  int (tau_x sin theta + sigma cos theta) d theta
+      F_y = -sign(beta) (r b int tau_y d theta + F_s)          T = r^2 b int tau_x d theta
+* sidewall resistance (Schwanghart; seed 003 eqs. 17--19, q = 0) on the side the wheel slides towards;
+* grouser forces (seed 003 eq. 20, passive earth pressure on each grouser in the soil, resolved along the
+  grouser's angle), spread over the contact as an average over one grouser pitch;
+* sinkage z from vertical equilibrium F_z(z) = W (Illinois false position, vectorised over conditions).
+"""
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+
+#: Gauss--Legendre nodes per contact region (front and rear of theta_m); 48 integrate the smooth stress
+#: profiles to better than 1e-8 relative (see tests/test_validation_terramechanics.py).
+QUADRATURE_POINTS = 48
+#: Reference gravity of the cohesion's gravity scaling [m/s^2].
+EARTH_GRAVITY = 9.81
+
+
+def _positive(name: str, value: float, *, allow_zero: bool = False) -> None:
+    ok = np.isfinite(value) and (value >= 0.0 if allow_zero else value > 0.0)
+    if not ok:
+        raise WheelsoilInputError(f"{name} = {value!r} is out of range: allowed {name} {'>=' if allow_zero else '>'} 0")
+
+
+@dataclass(frozen=True)
+class SoilParameters:
+    """Terramechanics soil parameters (SI; seed 003 Table III gives typical values for dry sand).
+
+    density: bulk density rho [kg/m^3].
+    cohesion: c [Pa].
+    friction_angle: internal friction angle phi [deg], in (0, 60).
+    kc_prime, kphi_prime: Reece's dimensionless pressure--sinkage moduli k'_c, k'_phi [-].
+    n0: sinkage exponent [-]; n1: slip-sinkage coefficient, n = n0 + n1 |i| [-].
+    shear_modulus_x, shear_modulus_y: shear deformation moduli k_x, k_y [m].
+    a1, a2: theta_m = (a1 + a2 i) theta_f [-] (Oida; Wong--Reece).
+    c3: exit angle ratio, theta_r = -c3 theta_f [-] (0: the soil does not rebound behind the wheel).
+
+    Mechanisms beyond the classical model (see :mod:`wheelsoil.validation.extensions`, which names them):
+
+    soil_flow: mean tangential speed of the soil under the rim as a fraction eta = v_soil / (r omega) of the
+        rim speed; it reduces the shear displacement, j_x = r((theta_f - theta)(1 - eta) - (1 - i)(sin
+        theta_f - sin theta)) (seed 000 eq. 8). 0: the soil under the wheel is at rest.
+    sidewall_scale: factor on Schwanghart's sidewall resistance (seed 003 eq. 19); 0 leaves it out.
+    grouser_scale: factor on the grouser forces (seed 003 eq. 20); 0 leaves them out.
+    radius_scale: surrogate radius R = radius_scale r of a flexible wheel's flattened contact (seed 000,
+        effective radius; Table 3); 1: rigid.
+    grouser_tip_fraction: lambda of a grousered wheel's shearing radius r + lambda h: the soil between the
+        grousers moves with the wheel and fails at the grouser tips (the lugged-wheel idealisation of Wong's
+        Theory of Ground Vehicles; seed 000 measures the soil velocity "near the tip of the grousers"); 0: the
+        rim radius.
+    cohesion_gravity_exponent: cohesion scales as c (g / 9.81)^kappa (seed 000: soil strength measured at
+        reduced gravity is lower); 0: cohesion independent of gravity.
+    """
+
+    density: float = 1600.0
+    cohesion: float = 1500.0
+    friction_angle: float = 35.0
+    kc_prime: float = 100.0
+    kphi_prime: float = 1000.0
+    n0: float = 1.1
+    n1: float = 0.0
+    shear_modulus_x: float = 0.015
+    shear_modulus_y: float = 0.015
+    a1: float = 0.33
+    a2: float = 0.11
+    c3: float = 0.0
+    soil_flow: float = 0.0
+    sidewall_scale: float = 1.0
+    grouser_scale: float = 1.0
+    radius_scale: float = 1.0
+    grouser_tip_fraction: float = 0.0
+    cohesion_gravity_exponent: float = 0.0
+
+    def __post_init__(self) -> None:
+        for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
+            _positive(key, getattr(self, key))
+        for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "grouser_scale", "grouser_tip_fraction"):
+            _positive(key, getattr(self, key), allow_zero=True)
+        if not (0.0 < self.friction_angle < 60.0):
+            raise WheelsoilInputError(
+                f"friction_angle = {self.friction_angle!r} deg is out of range: allowed 0 < friction_angle < 60")
+        if not (np.isfinite(self.soil_flow) and 0.0 <= self.soil_flow < 1.0):
+            raise WheelsoilInputError(f"soil_flow = {self.soil_flow!r} is out of range: allowed 0 <= soil_flow < 1")
+        if not (np.isfinite(self.radius_scale) and self.radius_scale >= 1.0):
+            raise WheelsoilInputError(f"radius_scale = {self.radius_scale!r} is out of range: allowed radius_scale >= 1")
+        if not np.isfinite(self.cohesion_gravity_exponent):
+            raise WheelsoilInputError(f"cohesion_gravity_exponent = {self.cohesion_gravity_exponent!r} must be finite")
+        if not (np.isfinite(self.n1) and self.n0 + min(self.n1, 0.0) > 0.0):
+            raise WheelsoilInputError(f"n1 = {self.n1!r} makes the sinkage exponent n0 + n1 |i| non-positive")
+        if not (np.isfinite(self.a1) and np.isfinite(self.a2) and 0.0 <= self.a1 < 1.0 and 0.0 <= self.a1 + self.a2 <= 1.0):
+            raise WheelsoilInputError(
+                f"a1 = {self.a1!r}, a2 = {self.a2!r} put theta_m outside the contact: allowed 0 <= a1 < 1 and "
+                f"0 <= a1 + a2 <= 1")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class RigidWheel:
+    """A rigid cylindrical wheel [m]; grousers of height ``grouser_height`` (0: smooth)."""
+
+    radius: float
+    width: float
+    grouser_height: float = 0.0
+    grouser_count: int = 0
+
+    def __post_init__(self) -> None:
+        _positive("radius", self.radius)
+        _positive("width", self.width)
+        _positive("grouser_height", self.grouser_height, allow_zero=True)
+        if self.grouser_height >= self.radius:
+            raise WheelsoilInputError(f"grouser_height = {self.grouser_height} must be smaller than the radius {self.radius}")
+        if int(self.grouser_count) != self.grouser_count or self.grouser_count < 0:
+            raise WheelsoilInputError(f"grouser_count = {self.grouser_count!r} must be a whole number >= 0")
+
+
+def _conditions(slip, slip_angle, load, gravity):
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (slip, slip_angle, load, gravity)))
+    slip, beta_deg, load, gravity = (a.ravel().copy() for a in arrays)
+    for name, a, ok, allowed in (
+        ("slip", slip, (slip >= -1.0) & (slip < 1.0), "-1 <= slip < 1"),
+        ("slip_angle", beta_deg, np.abs(beta_deg) < 90.0, "-90 < slip_angle < 90 deg"),
+        ("load", load, load > 0.0, "load > 0 N"),
+        ("gravity", gravity, gravity > 0.0, "gravity > 0 m/s^2"),
+    ):
+        bad = ~(np.isfinite(a) & ok)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise WheelsoilInputError(f"{name}[{k}] = {float(a[k])!r} is out of range: allowed {allowed}")
+    return arrays[0].shape, slip, np.radians(beta_deg), load, gravity
+
+
+def _gauss(lo: np.ndarray, hi: np.ndarray, nodes: np.ndarray, weights: np.ndarray):
+    """Quadrature points (C, Q) and weights (C, Q) on [lo, hi] per condition."""
+    half = 0.5 * (hi - lo)[:, None]
+    return 0.5 * (hi + lo)[:, None] + half * nodes[None, :], half * weights[None, :]
+
+
+def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity) -> dict:
+    """Soil forces on the wheel at a given sinkage (arrays broadcast together; ``slip_angle`` in degrees).
+
+    Returns a dict of 1-D arrays: drawbar_pull, lateral_force, vertical_force, torque [N, N m] and the
+    contact angles theta_f, theta_m, theta_r [rad].
+    """
+    z, i, beta_deg, g = (a.ravel() for a in np.broadcast_arrays(*(np.asarray(v, float) for v in
+                                                                    (sinkage, slip, slip_angle, gravity))))
+    beta = np.radians(beta_deg)
+    r, b = (wheel.radius + soil.grouser_tip_fraction * wheel.grouser_height) * soil.radius_scale, wheel.width
+    phi = np.radians(soil.friction_angle)
+    cohesion = soil.cohesion * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent
+    theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
+    theta_m = np.clip(soil.a1 + soil.a2 * i, 0.0, 1.0) * theta_f
+    theta_r = -soil.c3 * theta_f
+    n = soil.n0 + soil.n1 * np.abs(i)
+    k_pressure = (cohesion * soil.kc_prime + soil.density * g * b * soil.kphi_prime) * (r / b) ** n
+
+    x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
+    th_front, w_front = _gauss(theta_m, theta_f, x, w)
+    th_rear, w_rear = _gauss(theta_r, theta_m, x, w)
+    span = np.where(theta_m - theta_r > 0.0, theta_m - theta_r, 1.0)[:, None]
+    equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
+    theta = np.concatenate([th_front, th_rear], axis=1)
+    weight = np.concatenate([w_front, w_rear], axis=1)
+    stress_angle = np.concatenate([th_front, equivalent], axis=1)
+    sigma = k_pressure[:, None] * np.clip(np.cos(stress_angle) - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
+
+    tf = theta_f[:, None]
+    driving = i[:, None] >= 0.0
+    # seed 003 eq. 12 (driving / braking) and eq. 16
+    sweep = (tf - theta) * (1.0 - soil.soil_flow)  # seed 000 eq. 8: the soil under the rim moves with it
+    jx = np.where(driving, r * (sweep - (1.0 - i[:, None]) * (np.sin(tf) - np.sin(theta))),
+                  r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
+    jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
+    jy = jy * np.abs(np.tan(beta))[:, None]
+    strength = cohesion[:, None] + sigma * np.tan(phi)
+    tau_x = strength * (1.0 - np.exp(-jx / soil.shear_modulus_x))
+    tau_y = strength * (1.0 - np.exp(-jy / soil.shear_modulus_y))
+
+    fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
+    fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
+    torque = r * r * b * np.sum(weight * tau_x, axis=1)
+    f_lateral = r * b * np.sum(weight * tau_y, axis=1)
+    if soil.sidewall_scale > 0.0:
+        f_lateral = f_lateral + soil.sidewall_scale * sidewall_force(soil, wheel, z, beta, g)
+    if wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0:
+        gx, gz, gt = grouser_forces(soil, wheel, theta_f, theta_r, g)
+        fx = fx + soil.grouser_scale * gx
+        fz = fz + soil.grouser_scale * gz
+        torque = torque + soil.grouser_scale * gt
+    return {
+        "drawbar_pull": fx,
+        "lateral_force": -np.sign(beta) * f_lateral,
+        "vertical_force": fz,
+        "torque": torque,
+        "theta_f": theta_f,
+        "theta_m": theta_m,
+        "theta_r": theta_r,
+    }
+
+
+def bearing_capacity_factors(friction_angle_deg: float) -> tuple[float, float, float]:
+    """Modified Terzaghi factors (N_gamma, N_c, N_q) of seed 003 eq. 18 (Coduto 2001)."""
+    phi = np.radians(friction_angle_deg)
+    n_q = np.exp((1.5 * np.pi - phi) * np.tan(phi)) / (2.0 * np.cos(np.pi / 4 + phi / 2) ** 2)
+    n_gamma = 2.0 * (n_q + 1.0) * np.tan(phi) / (1.0 + 0.4 * np.sin(4.0 * phi))
+    n_c = (n_q - 1.0) / np.tan(phi)
+    return float(n_gamma), float(n_c), float(n_q)
+
+
+def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravity) -> np.ndarray:
+    """Schwanghart's sidewall resistance (seed 003 eq. 19, surcharge q = 0) [N], magnitude.
+
+    F_s = |sin beta| int_{-r sin theta_f}^{r sin theta_f} (gamma N_gamma f(x) + c N_c) f(x) dx with
+    f(x) = sqrt(r^2 - x^2) - r cos theta_f the depth of the sidewall below the surface.
+    """
+    r = wheel.radius
+    z = np.asarray(sinkage, float)
+    n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
+    theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
+    half = r * np.sin(theta_f)
+    x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
+    xs = half[:, None] * x[None, :]
+    depth = np.clip(np.sqrt(r * r - xs * xs) - r * np.cos(theta_f)[:, None], 0.0, None)
+    gamma = soil.density * np.asarray(gravity, float)
+    integral = np.sum(half[:, None] * w[None, :] * (gamma[:, None] * n_gamma * depth + soil.cohesion * n_c) * depth,
+                      axis=1)
+    return np.abs(np.sin(beta)) * integral
+
+
+def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gravity):
+    """Grouser forces (seed 003 eq. 20, surcharge q = 0): passive earth pressure on each grouser in the soil.
+
+    A grouser at angle theta carries F_g = b (rho g h^2 N_phi / 2 + 2 c h sqrt(N_phi)) normal to its radial
+    face, i.e. tangential to the wheel: forward thrust F_g cos theta and lift F_g sin theta, acting about
+    h / 3 inside the tip (seed 003: at about 2/3 of the grouser height), so the motor supplies
+    F_g (r + h / 3). Averaged over one grouser pitch, count / (2 pi) grousers per radian of contact arc.
+    Returns (F_x, F_z, T) [N, N, N m].
+    """
+    h, b, r = wheel.grouser_height, wheel.width, wheel.radius
+    n_phi = np.tan(np.pi / 4 + np.radians(soil.friction_angle) / 2) ** 2
+    per_grouser = b * (0.5 * soil.density * np.asarray(gravity, float) * h * h * n_phi
+                       + 2.0 * soil.cohesion * h * np.sqrt(n_phi))
+    per_radian = per_grouser * wheel.grouser_count / (2.0 * np.pi)
+    fx = per_radian * (np.sin(theta_f) - np.sin(theta_r))  # int cos(theta) d theta over the contact
+    fz = per_radian * (np.cos(theta_r) - np.cos(theta_f))  # int sin(theta) d theta
+    torque = per_radian * (theta_f - theta_r) * (r + h / 3.0)
+    return fx, fz, torque
+
+
+def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=9.81,
+            max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10, max_iterations: int = 200) -> dict:
+    """Steady-state forces and sinkage for each condition (arrays broadcast together).
+
+    Solves F_z(z) = W for the sinkage z in (0, max_sinkage_ratio r) (F_z rises with z) by the Illinois
+    variant of false position, vectorised over conditions, to |F_z - W| <= tolerance W; then evaluates
+    :func:`contact_forces`. Returns arrays shaped like the broadcast inputs: sinkage [m], drawbar_pull,
+    lateral_force, vertical_force [N], torque [N m], theta_f, theta_m, theta_r [rad], and ``supported``
+    (False where even z = max_sinkage_ratio r cannot carry W; those rows hold that sinkage).
+    """
+    shape, i, beta, load, g = _conditions(slip, slip_angle, load, gravity)
+    beta_deg = np.degrees(beta)
+
+    def excess(z):
+        return contact_forces(soil, wheel, z, i, beta_deg, g)["vertical_force"] - load
+
+    lo, f_lo = np.zeros_like(load), -load.copy()
+    hi = np.full_like(load, max_sinkage_ratio * wheel.radius)
+    f_hi = excess(hi)
+    supported = f_hi >= 0.0
+    z = hi.copy()
+    side = np.zeros(load.shape, int)  # which end the last step kept (-1 lo, +1 hi) for the Illinois rule
+    active = supported & (np.abs(f_hi) > tolerance * load)
+    for _ in range(max_iterations):
+        if not active.any():
+            break
+        cand = np.where(active, hi - f_hi * (hi - lo) / np.where(f_hi != f_lo, f_hi - f_lo, 1.0), z)
+        cand = np.where((cand > lo) & (cand < hi), cand, 0.5 * (lo + hi))  # guard against round-off
+        f = excess(cand)
+        z = np.where(active, cand, z)
+        below = active & (f < 0.0)  # root above cand: cand becomes the new lo
+        above = active & (f >= 0.0)
+        # Illinois: when the same end survives twice, halve its function value
+        f_hi = np.where(below & (side == -1), 0.5 * f_hi, f_hi)
+        f_lo = np.where(above & (side == 1), 0.5 * f_lo, f_lo)
+        lo, f_lo = np.where(below, cand, lo), np.where(below, f, f_lo)
+        hi, f_hi = np.where(above, cand, hi), np.where(above, f, f_hi)
+        side = np.where(below, -1, np.where(above, 1, side))
+        active &= np.abs(f) > tolerance * load
+    else:
+        raise RuntimeError(f"sinkage did not converge in {max_iterations} iterations")
+    z = np.where(supported, z, max_sinkage_ratio * wheel.radius)
+    out = contact_forces(soil, wheel, z, i, beta_deg, g)
+    out["sinkage"] = z
+    out["supported"] = supported
+    return {k: np.reshape(v, shape) for k, v in out.items()}

@@ -1,0 +1,110 @@
+"""``wheelsoil validate``: measured (or synthetic) data in, a report of what the classical model gets wrong,
+the named cause and the measured gain out."""
+
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+
+from .discovery import RESPONSES, discover, holdout_mask
+from .extensions import EXTENSIONS
+from .measured import Measurements, load_measurements, save_measurements
+from .report import write_report
+from .synthetic import HIDDEN_RANGES, draw_hidden_effect, synthetic_measurements
+
+#: The model's steering-angle domain: lateral shear displacement ~ tan(beta).
+MAX_SLIP_ANGLE = 80.0
+
+
+def prepare(data: Measurements) -> tuple[Measurements, tuple, str]:
+    """Rows the model can describe, the responses to fit, and a note of what was left out and why."""
+    notes = []
+    keep = (data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) <= MAX_SLIP_ANGLE) & (data.load > 0)
+    if (~keep).any():
+        notes.append(f"{int((~keep).sum())} rows outside the model's domain (driving slip 0 <= i < 1, "
+                     f"|slip angle| <= {MAX_SLIP_ANGLE:g} deg)")
+    data = data.select(keep)
+    responses = [q for q in RESPONSES if np.isfinite(data.responses[q]).any()]
+    if "start position" in data.notes and "sinkage" in responses:
+        responses.remove("sinkage")
+        notes.append("sinkage (its zero is the wheel's start position, not the soil surface)")
+    return data, tuple(responses), "; ".join(notes)
+
+
+def parse_holdout(spec: str | None, data: Measurements, seed: int) -> np.ndarray:
+    if spec is None:
+        return holdout_mask(data, seed=seed)
+    m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+0-9.eE]+|\w+)\s*", spec)
+    conditions = ("slip", "slip_angle", "load", "gravity", "grouser_height", "group")
+    if not m or m.group(1) not in conditions:
+        raise WheelsoilInputError(f"--holdout {spec!r}: expected CONDITION=VALUE with CONDITION one of {list(conditions)}")
+    key, value = m.group(1), m.group(2)
+    return holdout_mask(data, by=key, level=value if key == "group" else float(value))
+
+
+def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
+             seed: int = 0, group: str | None = None, command: str = "") -> dict:
+    """Load (or synthesise) the data, run discovery, write the report; returns the findings dict."""
+    if data_arg == "synthetic":
+        rng = np.random.default_rng(seed)
+        if hidden is None:
+            name, params = draw_hidden_effect(rng, list(HIDDEN_RANGES) + [None])
+        elif hidden == "none":
+            name, params = None, {}
+        elif hidden in HIDDEN_RANGES:
+            name, params = draw_hidden_effect(rng, [hidden])
+        else:
+            raise WheelsoilInputError(f"--hidden {hidden!r}: choose 'none' or one of {sorted(HIDDEN_RANGES)}")
+        data = synthetic_measurements(params, rng)
+        report.mkdir(parents=True, exist_ok=True)
+        save_measurements(data, report / "synthetic_data.csv")
+        title = "Validation on synthetic data (the hidden mechanism is revealed at the end)"
+    else:
+        if hidden is not None:
+            raise WheelsoilInputError("--hidden applies to 'synthetic' data only")
+        data = load_measurements(data_arg)
+        title = f"Validation against {data.name}"
+        name = params = None
+    if group is not None:
+        rows = np.char.startswith(data.group.astype(str), group)
+        if not rows.any():
+            raise WheelsoilInputError(f"--group {group!r} matches no rows; groups are {sorted(set(map(str, data.group)))}")
+        data = data.select(rows)
+        data.name = f"{data.name} [{group}]"
+    data, default_responses, excluded = prepare(data)
+    mask = parse_holdout(holdout, data, seed)
+    d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed)
+    md, js = write_report(d, data, mask, report, title=title, command=command, excluded=excluded)
+    if data_arg == "synthetic":
+        with open(md, "a") as fh:
+            fh.write(f"\n## The hidden truth\n\nHidden: {name or 'nothing'} {params or ''}\n")
+    import json
+
+    findings = json.loads(js.read_text())
+    findings["report"] = str(md)
+    if data_arg == "synthetic":
+        findings["hidden"] = {"name": name, "parameters": params}
+    return findings
+
+
+def main_validate(args) -> int:
+    from rich.console import Console
+
+    console = Console()
+    command = "wheelsoil " + " ".join(getattr(args, "argv", None) or sys.argv[1:])
+    findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
+                        hidden=args.hidden, seed=args.seed, group=args.group, command=command)
+    base = findings["baseline"]
+    console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out)")
+    for c in findings["candidates"]:
+        console.print(f"  {c['name']:18s} gain {c['gain']:+.4f} +- {c['gain_std']:.4f}  dBIC {c['delta_bic']:+8.1f}"
+                      f"{'  FOUND' if c['found'] else ''}")
+    f = findings["found"]
+    console.print(f"found: [bold]{f['name']}[/bold] ({EXTENSIONS[f['name']].source})" if f else "found: nothing")
+    if "hidden" in findings:
+        console.print(f"hidden: {findings['hidden']['name']} {findings['hidden']['parameters']}")
+    console.print(f"wrote {findings['report']} and {Path(findings['report']).with_name('findings.json')}")
+    return 0
