@@ -111,7 +111,8 @@ class Measurements:
     Conditions: slip, slip_angle, load, gravity, and the wheel of each row (radius, width, grouser_height,
     grouser_count) plus a ``group`` label (e.g. wheel type or source). Responses: ``responses[name]``
     for drawbar_pull, lateral_force, sinkage, torque (NaN where not measured) and ``std[name]`` where the
-    data give a standard deviation.
+    data give a standard deviation. ``sinkage_relative``: the sinkage's zero is not the soil surface
+    (e.g. the wheel's start position), so only its changes are comparable with a model.
     """
 
     name: str
@@ -127,6 +128,7 @@ class Measurements:
     responses: dict[str, np.ndarray]
     std: dict[str, np.ndarray] = field(default_factory=dict)
     notes: str = ""
+    sinkage_relative: bool = False
 
     def __len__(self) -> int:
         return len(self.slip)
@@ -137,7 +139,7 @@ class Measurements:
         return Measurements(self.name, *(pick(getattr(self, k)) for k in (
             "slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")),
             responses={k: pick(v) for k, v in self.responses.items()}, std={k: pick(v) for k, v in self.std.items()},
-            notes=self.notes)
+            notes=self.notes, sinkage_relative=self.sinkage_relative)
 
 
 #: CMU K10-mini wheel (robomechanics/3d-terramechanics parameter files, see the dataset README).
@@ -177,6 +179,7 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
         std={"drawbar_pull": cols("drawbar_pull_std"), "lateral_force": cols("lateral_force_std"),
              "vertical_load": cols("vertical_load_std")},
         notes="Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position",
+        sinkage_relative=True,
     )
     if driving_only:
         data = data.select((data.slip >= 0.0) & (data.slip < 1.0))

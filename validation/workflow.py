@@ -28,7 +28,7 @@ def prepare(data: Measurements) -> tuple[Measurements, tuple, str]:
                      f"|slip angle| <= {MAX_SLIP_ANGLE:g} deg)")
     data = data.select(keep)
     responses = [q for q in RESPONSES if np.isfinite(data.responses[q]).any()]
-    if "start position" in data.notes and "sinkage" in responses:
+    if data.sinkage_relative and "sinkage" in responses:
         responses.remove("sinkage")
         notes.append("sinkage (its zero is the wheel's start position, not the soil surface)")
     return data, tuple(responses), "; ".join(notes)
