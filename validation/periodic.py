@@ -1,0 +1,166 @@
+"""Periodic components in measured time series, and the mechanism whose frequency law explains them.
+
+Seed 002 finds drawbar-pull and torque oscillations on a smooth wheel in sand whose frequency falls
+linearly with slip (eq. 25, omega_osc = -36.9 i + 36.5 rad/s) and whose amplitude scales with the contact
+length (eq. 24); on grousered wheels the oscillation follows the grouser spacing (its ref. [11]); a
+flexible wheel's stiffness peaks at its (virtual) spokes (seed 000 eq. 19, six per turn on the ExoMars
+wheel). Each of these is a frequency law for a run at wheel speed omega and slip i:
+
+* ``grouser_passing``: f = N_g omega / (2 pi) (N_g grousers per turn);
+* ``spoke_stiffness``: f = N_s omega / (2 pi) (N_s spokes or stiffness peaks per turn);
+* ``wheel_rotation``: f = omega / (2 pi) (run-out, once per turn);
+* ``slip_density_wave``: f = a + b i (seed 002 eqs. 20, 25; two parameters fitted across runs).
+
+:func:`dominant_component` finds the strongest sinusoid of one series (linear trend removed, periodogram
+peak refined by least squares) and tests it against white noise with Fisher's g statistic.
+:func:`explain_frequencies` compares the laws across runs by the spread of the measured frequencies
+about each law, with BIC charging the slip law for its two parameters: it must beat the best counting law
+by :data:`BIC_MARGIN`.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import periodogram
+
+from wheelsoil.errors import WheelsoilInputError
+
+#: p-value below which a periodogram peak counts as a periodic component.
+SIGNIFICANCE = 1e-3
+#: Relative frequency tolerance of the counting laws (a frequency within it matches the law).
+LAW_TOLERANCE = 0.05
+#: BIC advantage the two-parameter slip law needs over a parameter-free counting law (strong evidence).
+BIC_MARGIN = 10.0
+
+
+@dataclass
+class Component:
+    """The strongest sinusoid of a series: y ~ A sin(2 pi f t + phase) about a linear trend."""
+
+    frequency: float  # [Hz]
+    amplitude: float  # [units of y]
+    phase: float  # [rad]
+    p_value: float  # Fisher's g test against white noise
+    explained: float  # fraction of the detrended variance the sinusoid explains
+
+    @property
+    def significant(self) -> bool:
+        return self.p_value < SIGNIFICANCE
+
+
+def _comb(m: int, k: int) -> float:
+    from math import comb
+
+    return float(comb(m, k))
+
+
+def fisher_g(power: np.ndarray) -> float:
+    """p-value of Fisher's g = max / sum of m periodogram ordinates under white noise (exact series,
+    truncated where its terms vanish)."""
+    power = np.asarray(power, float)
+    m = power.size
+    g = float(power.max() / power.sum())
+    total = 0.0
+    for k in range(1, int(np.floor(1.0 / g)) + 1):
+        total += (-1.0) ** (k - 1) * _comb(m, k) * (1.0 - k * g) ** (m - 1)
+    return float(np.clip(total, 0.0, 1.0))
+
+
+def dominant_component(t, y, *, min_cycles: float = 2.0) -> Component:
+    """The strongest periodic component of a uniformly sampled series (``t`` [s], ``y``).
+
+    Frequencies with fewer than ``min_cycles`` periods in the record are not considered (a trend is not an
+    oscillation). Raises a clear error for records that are too short or not uniformly sampled.
+    """
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    if t.shape != y.shape or t.ndim != 1 or t.size < 16:
+        raise WheelsoilInputError(f"a time series needs matching 1-D t and y of at least 16 samples, got {t.shape}, {y.shape}")
+    dt = np.diff(t)
+    if not (np.all(dt > 0) and np.ptp(dt) <= 1e-4 * dt.mean()):  # 1e-4: times written with 9 digits
+        raise WheelsoilInputError("the time series must be uniformly sampled with increasing t")
+    fs = 1.0 / dt.mean()
+    design = np.stack([np.ones_like(t), t - t.mean()], axis=1)
+    trend = design @ np.linalg.lstsq(design, y, rcond=None)[0]
+    r = y - trend
+    f, p = periodogram(r, fs=fs, detrend=False, scaling="spectrum")
+    keep = f >= min_cycles / (t[-1] - t[0])
+    keep[-1] = keep[-1] and (t.size % 2 == 1)  # the Nyquist ordinate has one degree of freedom
+    if keep.sum() < 4:
+        raise WheelsoilInputError(f"the record ({t[-1] - t[0]:.3g} s at {fs:.3g} Hz) is too short for {min_cycles} cycles")
+    f, p = f[keep], p[keep]
+    p_value = fisher_g(p)
+    f0 = f[np.argmax(p)]
+
+    # refine: the trend and the sinusoid fitted together (a separate detrend would take part of a
+    # slow oscillation with few cycles in the record)
+    tc = t - t.mean()
+
+    def resid(x):
+        freq, a, b, c0, c1 = x
+        w = 2 * np.pi * freq * (t - t[0])
+        return y - a * np.sin(w) - b * np.cos(w) - c0 - c1 * tc
+
+    w0 = 2 * np.pi * f0 * (t - t[0])
+    a0, b0, c00, c10 = np.linalg.lstsq(np.stack([np.sin(w0), np.cos(w0), np.ones_like(t), tc], axis=1), y,
+                                       rcond=None)[0]
+    df = f[1] - f[0] if f.size > 1 else f0
+    inf = np.inf
+    sol = least_squares(resid, [f0, a0, b0, c00, c10], bounds=([f0 - df, -inf, -inf, -inf, -inf], [f0 + df, inf, inf, inf, inf]))
+    freq, a, b = sol.x[:3]
+    explained = 1.0 - float(np.sum(resid(sol.x) ** 2) / np.sum(r ** 2))
+    return Component(float(freq), float(np.hypot(a, b)), float(np.arctan2(b, a)), p_value, explained)
+
+
+@dataclass
+class Run:
+    """One steady run: wheel speed omega [rad/s], slip, and its series' dominant component."""
+
+    omega: float
+    slip: float
+    component: Component
+
+
+def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) -> dict:
+    """Which frequency law explains the significant components of ``runs`` (see the module docstring).
+
+    Returns {"found": law name or None, "laws": {name: {"rms_relative_error", "bic", "parameters"}},
+    "significant_runs": n}. A counting law is found when every significant frequency lies within
+    :data:`LAW_TOLERANCE` of it; the slip law when it fits with lower BIC than every counting law and its
+    relative error is within the same tolerance. Nothing is found without significant components in at
+    least three runs.
+    """
+    sig = [r for r in runs if r.component.significant]
+    out = {"found": None, "laws": {}, "significant_runs": len(sig)}
+    if len(sig) < 3:
+        return out
+    f = np.array([r.component.frequency for r in sig])
+    omega = np.array([r.omega for r in sig])
+    slip = np.array([r.slip for r in sig])
+    n = f.size
+    laws = {"wheel_rotation": omega / (2 * np.pi)}
+    if grousers:
+        laws["grouser_passing"] = grousers * omega / (2 * np.pi)
+    if spokes:
+        laws["spoke_stiffness"] = spokes * omega / (2 * np.pi)
+    for name, pred in laws.items():
+        rel = (f - pred) / f
+        out["laws"][name] = {"rms_relative_error": float(np.sqrt(np.mean(rel ** 2))), "parameters": {},
+                             "bic": n * np.log(max(np.mean(rel ** 2), 1e-300))}
+    if np.ptp(slip) > 0:
+        coef = np.polyfit(slip, f, 1)
+        rel = (f - np.polyval(coef, slip)) / f
+        out["laws"]["slip_density_wave"] = {
+            "rms_relative_error": float(np.sqrt(np.mean(rel ** 2))),
+            "parameters": {"a_hz": float(coef[1]), "b_hz": float(coef[0])},
+            "bic": n * np.log(max(np.mean(rel ** 2), 1e-300)) + 2 * np.log(n),
+        }
+    counting = [k for k in out["laws"] if k != "slip_density_wave"]
+    best = min(counting, key=lambda k: out["laws"][k]["bic"])
+    slip_law = out["laws"].get("slip_density_wave")
+    # the two-parameter slip law must beat the best parameter-free counting law by strong evidence
+    if slip_law and slip_law["bic"] < out["laws"][best]["bic"] - BIC_MARGIN:
+        best = "slip_density_wave"
+    if out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE:
+        out["found"] = best
+    return out
