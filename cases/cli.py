@@ -32,6 +32,10 @@ the same wheel at Moon gravity with W = 500 N (equal wheel mass), or other rig s
     wheelsoil run smoke-moon-steer
     wheelsoil run smoke-1g-steer --slip 0.5 --slip-angle 20 --rigid --out runs/rigid
 
+hold the semi-empirical model against measured data and name what it misses:
+
+    wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --holdout slip_angle=60
+
 or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
     wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --gravity moon --out moon_bed.h5
