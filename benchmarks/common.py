@@ -18,6 +18,22 @@ def peak_rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+def own_peak_rss_mib() -> float:
+    """Peak resident memory of this process's own address space [MiB] (``VmHWM``).
+
+    ``getrusage``'s maximum survives fork and exec, so a child started by a large parent would report at
+    least the parent's size; the high-water mark of the address space does not.
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return peak_rss_mib()
+
+
 def machine() -> dict:
     """What the figures were measured on."""
     cpu = platform.processor() or ""

@@ -27,26 +27,10 @@ import time
 from pathlib import Path
 
 from wheelsoil import runtime
-from wheelsoil.benchmarks.common import machine, peak_rss_mib, versions
+from wheelsoil.benchmarks.common import machine, own_peak_rss_mib, versions
 
 SEED004_PARTICLES = 388_026
 SEED004_DRIVE_TIME = 2.5
-
-
-def own_peak_rss_mib() -> float:
-    """Peak resident memory of this process's own address space [MiB] (``VmHWM``).
-
-    ``getrusage``'s maximum survives fork and exec, so a child started by a large parent would report at
-    least the parent's size; the high-water mark of the address space does not.
-    """
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) / 1024.0
-    except OSError:
-        pass
-    return peak_rss_mib()
 
 
 def _timed(obj, name: str, totals: dict, key: str) -> None:

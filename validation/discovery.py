@@ -211,10 +211,6 @@ class Discovery:
         }
 
 
-def _heldout_errors(soil, data, mask, responses, scales) -> np.ndarray:
-    return normalised_residuals(soil, data.select(mask), responses, scales)
-
-
 def mechanism_effect(soil: SoilParameters, extension: Extension, data: Measurements, responses, scales) -> float:
     """RMS over conditions and responses of what ``extension`` adds to the model ``soil`` (normalised).
 
@@ -268,7 +264,7 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
     scales = response_scales(data, responses)
     base_start = replace(start or SoilParameters(), **BASELINE_OFF)
     baseline = _best_baseline(train, base_start, responses, scales)
-    base_err = _heldout_errors(baseline.soil, data, heldout, responses, scales)
+    base_err = normalised_residuals(baseline.soil, test, responses, scales)
     base_rmse = float(np.sqrt(np.mean(base_err ** 2)))
 
     names = list(candidates or EXTENSIONS)
@@ -280,7 +276,7 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
             continue
         ext = EXTENSIONS[name]
         fit = _best_extended(train, baseline.soil, base_start, ext, responses, scales)
-        err = _heldout_errors(fit.soil, data, heldout, responses, scales)
+        err = normalised_residuals(fit.soil, test, responses, scales)
         rmse = float(np.sqrt(np.mean(err ** 2)))
         # bootstrap over held-out residuals (paired): the spread of the RMSE difference
         idx = rng.integers(0, err.size, size=(bootstrap, err.size))

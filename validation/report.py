@@ -100,8 +100,9 @@ def plot_candidates(d: Discovery, path: Path) -> None:
 
 
 def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str | Path, *, title: str,
-                 command: str = "", excluded: str = "") -> tuple[Path, Path]:
-    """Write ``report.md``, ``findings.json`` and the figures to ``out``; returns the two paths."""
+                 command: str = "", excluded: str = "") -> tuple[Path, Path, dict]:
+    """Write ``report.md``, ``findings.json`` and the figures to ``out``; returns the two paths and the
+    findings (the JSON's content)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     plot_fits(d, data, heldout, out / "fits.png")
@@ -154,4 +155,4 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
         tmp.write_text(json.dumps(findings, indent=1, default=float))
     with atomic_output(md) as tmp:
         tmp.write_text("\n".join(lines))
-    return md, js
+    return md, js, findings

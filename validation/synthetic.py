@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .extensions import BASELINE_OFF, EXTENSIONS
+from .extensions import BASELINE_OFF
 from .measured import Measurements
 from .terramechanics import RigidWheel, SoilParameters, predict
 
@@ -73,7 +73,3 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
         notes=f"hidden: {hidden or 'nothing'}",
     )
 
-
-def extension_of(parameter: str) -> str:
-    """The extension that owns a parameter name."""
-    return next(name for name, e in EXTENSIONS.items() if any(p.name == parameter for p in e.parameters))

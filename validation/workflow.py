@@ -77,13 +77,10 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
     data, default_responses, excluded = prepare(data)
     mask = parse_holdout(holdout, data, seed)
     d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed)
-    md, js = write_report(d, data, mask, report, title=title, command=command, excluded=excluded)
+    md, _, findings = write_report(d, data, mask, report, title=title, command=command, excluded=excluded)
     if data_arg == "synthetic":
         with open(md, "a") as fh:
             fh.write(f"\n## The hidden truth\n\nHidden: {name or 'nothing'} {params or ''}\n")
-    import json
-
-    findings = json.loads(js.read_text())
     findings["report"] = str(md)
     if data_arg == "synthetic":
         findings["hidden"] = {"name": name, "parameters": params}
