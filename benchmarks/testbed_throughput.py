@@ -48,14 +48,14 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
 
 
 def smoke_part(steps: int, drive_time: float, arch) -> dict:
-    from wheelsoil.coupling.presets import preset_case
+    from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed
     from wheelsoil.granular import prepare_bed
 
-    case = preset_case("smoke-1g-steer", drive_time=drive_time)
-    bed = prepare_bed(case.bed, arch=arch)
+    case = load_case("smoke-1g-steer", [f"test.drive_time={drive_time!r}"])
+    bed = prepare_bed(case.bed_spec(), arch=arch)
     t0 = time.perf_counter()
-    bench = Testbed(bed, case.wheel, case.testbed, arch=arch)
+    bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
     setup = time.perf_counter() - t0
     result = bench.run()
     info = result.info
@@ -157,9 +157,9 @@ def _child(part: str, arch, steps: int) -> dict:
 
 def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
     """Seed-004 cost from the measured smoke-scale parts and the measured full-resolution wheel."""
-    from wheelsoil.coupling.presets import seed004_bed, smoke_bed
+    from wheelsoil.cases.schema import load_case
 
-    s_bed, f_bed = smoke_bed(), seed004_bed()
+    s_bed, f_bed = load_case("smoke-1g-steer").bed_spec(), load_case("seed004-1g-steer").bed_spec()
     # the DEM step scales with the smallest radius (Rayleigh and Hertz estimates are both ~ R)
     dt = smoke["dem_time_step_s"] * f_bed.diameter_min / s_bed.diameter_min
     particles = SEED004_PARTICLES / smoke["particles"]

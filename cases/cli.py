@@ -6,6 +6,7 @@ Exit codes (scripts can trust them):
        regression beyond the tolerance (``bench --smoke --baseline``)
     2  bad input (a parameter out of range, a missing file); the message names the value
     3  the simulation went unstable or did not settle; nothing was written
+    4  a sweep ran, but some of its cases failed (the others finished; see its status.json)
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import argparse
 import sys
 from pathlib import Path
 
-EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE = 0, 1, 2, 3
+EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
 GRAVITY_PRESETS = {"earth": 9.81, "moon": 9.81 / 6.0}
 
@@ -88,25 +89,62 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
     p = sub.add_parser("run", aliases=["testbed"],
-                       help="drive a wheel through a prepared bed (single-wheel testbed); default: the smoke job",
+                       help="run a testbed case (a TOML case file or a preset); default: the smoke job",
                        description="Run a testbed case: prepare (or reuse) its bed under the case's gravity, lower "
                                    "the wheel until the soil carries the load W, drive at the commanded slip and "
-                                   "steering angle, detect the steady state and average. Writes series.csv, "
-                                   "summary.json, series.png and a render of the last state (final.png) to --out. "
-                                   "Cases: smoke-1g-steer (the default; about 3 minutes on 2 cores with the bed, "
-                                   "W = 3000 N), smoke-moon-steer (1/6 g, W = 500 N), seed004-1g-steer and "
-                                   "seed004-moon-steer (full scale, hours). 'wheelsoil testbed' is the same command.")
-    p.add_argument("case", nargs="?", default="smoke-1g-steer",
-                   help="case name (smoke-1g-steer [default], smoke-moon-steer, seed004-1g-steer, seed004-moon-steer)")
-    p.add_argument("--slip", type=float, default=None, help="longitudinal slip i in [-1, 1) (default: the case's)")
-    p.add_argument("--slip-angle", type=float, default=None, help="steering angle beta [deg] in (-90, 90)")
-    p.add_argument("--load", type=float, default=None, help="vertical load W [N] > 0, wheel weight included")
-    p.add_argument("--drive-time", type=float, default=None, help="driving time [s]")
-    p.add_argument("--rigid", action="store_true", help="use the rigid wheel with the same surface")
-    p.add_argument("--no-render", action="store_true", help="skip the render of the last state")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case>)")
+                                   "steering angle, detect the steady state and average. Writes result.h5 (+ "
+                                   "result.xdmf for ParaView), series.csv, summary.json, case.toml (the resolved "
+                                   "case), series.png and a render of the last state (final.png) to --out. "
+                                   "CASE is a .toml file or a preset ('wheelsoil case list'): smoke-1g-steer (the "
+                                   "default; about 3 minutes on 2 cores with the bed, W = 3000 N), smoke-moon-steer "
+                                   "(1/6 g, W = 500 N), mini-1g-steer (20 s), seed004-1g-steer and seed004-moon-steer "
+                                   "(full scale, hours). A run killed after a checkpoint continues with --resume. "
+                                   "'wheelsoil testbed' is the same command.")
+    p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name "
+                                                                     "(default smoke-1g-steer)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
+                   help="override a case key, e.g. --set test.slip=0.5 --set soil.gravity=moon --set "
+                        "'test.drive_time=\"800 ms\"' (repeatable; 'wheelsoil case show' lists the keys)")
+    p.add_argument("--slip", type=float, default=None, help="shortcut for --set test.slip=VALUE")
+    p.add_argument("--slip-angle", type=float, default=None, help="shortcut for --set test.slip_angle=VALUE [deg]")
+    p.add_argument("--load", type=float, default=None, help="shortcut for --set test.load=VALUE [N]")
+    p.add_argument("--drive-time", type=float, default=None, help="shortcut for --set test.drive_time=VALUE [s]")
+    p.add_argument("--rigid", action="store_true", help="shortcut for --set wheel.rigid=true")
+    p.add_argument("--no-render", action="store_true", help="shortcut for --set output.render=false")
+    p.add_argument("--resume", action="store_true", help="continue a killed run of the same case from its last "
+                                                         "checkpoint in --out")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case name>)")
     p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
     p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("case", help="list the preset cases, show a case with every key, or check a case file",
+                       description="'wheelsoil case list' lists the presets; 'wheelsoil case show CASE' prints the "
+                                   "resolved case with every key, its unit, range and default (a template to copy); "
+                                   "'wheelsoil case check CASE' validates a case file and prints its hash.")
+    p.add_argument("action", choices=["list", "show", "check"])
+    p.add_argument("case", nargs="?", default=None, help="case file (.toml) or preset name")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override a case key (repeatable)")
+    p.set_defaults(func=cmd_case)
+
+    p = sub.add_parser("batch", help="run a sweep of cases (local processes or a dask cluster); summary and figures",
+                       description="Run a sweep file: a base case plus lists to combine (grid) or explicit rows "
+                                   "(cases/sweep.py documents the format; 'wheelsoil batch mini-slip' is a small "
+                                   "preset, seed004-figures the paper's 60 cases). Each case runs in its own process "
+                                   "and writes <out>/cases/<case hash>/; finished cases are skipped when the sweep "
+                                   "runs again, failed ones retried; one failing case never stops the others. Writes "
+                                   "status.json, summary.csv, summary.parquet and figure_{sinkage,drawbar_pull,"
+                                   "lateral_force}.png (seed 004 Figs. 6-8). Exit code 4 when some cases failed.")
+    p.add_argument("sweep", help="sweep file (.toml) or preset (mini-slip, smoke-figures, seed004-figures)")
+    p.add_argument("--out", type=Path, default=None, help="sweep folder (default wheelsoil-output/sweeps/<name>)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: the CPU count; a coupled run keeps about one core busy)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="dask.distributed scheduler (e.g. tcp://host:8786) to send the cases to instead; its workers "
+                        "need wheelsoil installed and the sweep folder on a shared file system")
+    p.add_argument("--timeout", type=float, default=None, help="give up a case after this many seconds (default: none)")
+    p.add_argument("--list", action="store_true", help="only list the cases and whether they are finished")
+    p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
+    p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin; write it to HDF5",
                        description="Fill a bin with polydisperse spheres, settle under gravity until the kinetic "
@@ -187,91 +225,83 @@ def cmd_validate(args) -> int:
     return main_validate(args)
 
 
-def cmd_run(args) -> int:
-    import json
+def _load_case_from_args(args):
+    from .schema import load_case
 
-    from wheelsoil.coupling.presets import preset_case
-    from wheelsoil.coupling.testbed import SERIES_UNITS, Testbed
-    from wheelsoil.granular import prepare_bed
-    from wheelsoil.provenance import atomic_output, provenance
+    overrides = list(args.set or [])
+    for key, value in (("slip", args.slip), ("slip_angle", args.slip_angle), ("load", args.load),
+                       ("drive_time", args.drive_time)):
+        if value is not None:
+            overrides.append(f"test.{key}={value!r}")
+    if args.rigid:
+        overrides.append("wheel.rigid=true")
+    if getattr(args, "no_render", False):
+        overrides.append("output.render=false")
+    return load_case(args.case, overrides)
+
+
+def cmd_run(args) -> int:
+    from .run import run_case
 
     console = _console()
-    overrides = {k: v for k, v in (("slip", args.slip), ("slip_angle", args.slip_angle), ("load", args.load),
-                                   ("drive_time", args.drive_time)) if v is not None}
-    if args.rigid:
-        overrides["rigid"] = True
-    case = preset_case(args.case, **overrides)
+    case = _load_case_from_args(args)
     out = args.out or Path("wheelsoil-output") / case.name
-    bed = prepare_bed(case.bed, progress=console.is_terminal, arch=args.arch)
-    console.print(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
-    bench = Testbed(bed, case.wheel, case.testbed, arch=args.arch)
-    console.print(f"wheel {case.wheel.name}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
-                  f"{'rigid' if case.testbed.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; "
-                  f"slip {case.testbed.slip:g}, steering {case.testbed.slip_angle:g} deg, W = {case.testbed.load:g} N")
-    result = bench.run(progress=console.is_terminal)
-    names = list(SERIES_UNITS)
-    rows = [",".join(f"{n}[{SERIES_UNITS[n]}]" for n in names)]
-    rows += [",".join(f"{result.series[n][k]:.9g}" for n in names) for k in range(len(result.series["t"]))]
-    with atomic_output(out / "series.csv") as tmp:
-        tmp.write_text("\n".join(rows) + "\n")
-    summary = {"case": case.name, "testbed": case.testbed.to_dict(), "bed": case.bed.to_dict(),
-               "wheel": case.wheel.name, "element_size_m": case.wheel.element_size, "summary": result.summary,
-               "run": result.info, "provenance": provenance()}
-    with atomic_output(out / "summary.json") as tmp:
-        tmp.write_text(json.dumps(summary, indent=2, default=str))
-    _plot_series(result, out / "series.png", case.name)
-    written = [out / "series.csv", out / "summary.json", out / "series.png"]
-    if not args.no_render:
-        from .render import render_testbed
-
-        with atomic_output(out / "final.png") as tmp:
-            image = tmp.with_suffix(".png")  # the renderer picks the format from the suffix
-            try:
-                render_testbed(result, image, title=f"{case.name}: end of the run")
-                image.replace(tmp)
-            finally:
-                image.unlink(missing_ok=True)
-        written.append(out / "final.png")
-    s = result.summary
+    outcome = run_case(case, out, arch=args.arch, resume=args.resume, progress=console.is_terminal, console=console)
+    s = outcome.testbed_result.summary
     console.print(("steady state" if s["steady"] else "[yellow]no steady state detected; averaged the last half[/]")
                   + f" over t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s:")
     for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
         console.print(f"  {q:15s} {s[q]['mean']:10.4g} +- {s[q]['std']:.3g} {s[q]['units']}")
-    console.print(f"{result.info['wall_seconds']:.0f} s wall for {result.info['simulated_seconds']:.2f} s simulated; "
-                  f"wrote {', '.join(str(w) for w in written)}")
+    info = outcome.testbed_result.info
+    console.print(f"{info['wall_seconds']:.0f} s wall for {info['simulated_seconds']:.2f} s simulated; "
+                  f"wrote {outcome.result_path} (+ .xdmf for ParaView), series.csv, summary.json, case.toml, "
+                  f"series.png{', final.png' if case.output.render else ''} in {out}")
     return EXIT_OK
 
 
-def _plot_series(result, path, title):
-    import matplotlib
+def cmd_batch(args) -> int:
+    import os
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from .sweep import load_sweep, run_sweep
 
-    from wheelsoil.provenance import atomic_output
+    console = _console()
+    sweep = load_sweep(args.sweep, args.out)
+    if args.list:
+        for c in sweep.cases:
+            console.print(f"{c.folder.name}  {'finished' if c.finished else 'to run  '}  {c.name}")
+        return EXIT_OK
+    if args.workers is not None and args.workers < 1:
+        raise _InputError(f"--workers {args.workers} must be >= 1")
+    if args.timeout is not None and not args.timeout > 0:
+        raise _InputError(f"--timeout {args.timeout} must be > 0 seconds")
+    workers = args.workers or os.cpu_count() or 1
+    status = run_sweep(sweep, workers=workers, scheduler=args.scheduler, arch=args.arch, progress=console.is_terminal,
+                       console=console, timeout=args.timeout)
+    failed = {k: v for k, v in status.items() if v["status"] == "failed"}
+    done = sum(v["status"] == "finished" for v in status.values())
+    console.print(f"sweep {sweep.name}: {done} run, {len(status) - done - len(failed)} skipped (finished before), "
+                  f"{len(failed)} failed; summary.csv, summary.parquet, figures and status.json in {sweep.out}")
+    for key, v in failed.items():
+        console.print(f"  [red]failed[/] {key}: {v.get('error')} (log: {sweep.out / 'cases' / key / 'run.log'})")
+    return EXIT_SWEEP_FAILED if failed else EXIT_OK
 
-    s, t = result.series, result.series["t"]
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-    for name in ("drawbar_pull", "lateral_force", "vertical_force"):
-        axes[0].plot(t, s[name], label=name.replace("_", " "))
-    axes[0].axhline(result.spec.load, color="0.5", ls="--", lw=0.8, label="load W")
-    axes[0].set_ylabel("force on the wheel [N]")
-    axes[1].plot(t, s["torque"], color="C3")
-    axes[1].set_ylabel("driving torque [N m]")
-    axes[2].plot(t, 1e3 * s["sinkage"], color="C4", label="hub (with deflection)")
-    axes[2].plot(t, 1e3 * s["tread_sinkage"], color="C5", label="tread")
-    axes[2].set_ylabel("sinkage [mm]")
-    axes[2].legend(fontsize=8)
-    axes[2].set_xlabel("time [s]")
-    t0, t1 = result.summary["window"]
-    for ax in axes:
-        ax.axvspan(t0, t1, color="0.9", zorder=0)
-    axes[0].legend(fontsize=8, ncol=2)
-    axes[0].set_title(f"{title} (shaded: averaging window)")
-    fig.tight_layout()
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+
+def cmd_case(args) -> int:
+    from .schema import case_to_toml, load_case, preset_names, preset_text
+
+    if args.action == "list":
+        for name in preset_names():
+            first = next((ln for ln in preset_text(name).splitlines() if ln.startswith("description")), "")
+            print(f"{name:22s} {first.split('=', 1)[-1].strip().strip(chr(34))}")
+        return EXIT_OK
+    if not args.case:
+        raise _InputError("give a case file or preset name ('wheelsoil case list' shows the presets)")
+    case = load_case(args.case, args.set or [])
+    if args.action == "show":
+        print(case_to_toml(case), end="")
+    else:  # check
+        print(f"{args.case}: valid; case {case.name}, hash {case.case_hash()}")
+    return EXIT_OK
 
 
 def cmd_wheel(args) -> int:

@@ -276,6 +276,35 @@ class WheelContact(Interaction):
             self._resultant.from_numpy(r)
         return out
 
+    # ------------------------------------------------------------------ checkpoints
+    _STATE_SCALARS = ("rebuilds", "structure_substeps", "_steps", "_n_contacts")
+
+    def state(self) -> dict:
+        """Per-particle contact history, the force accumulators and counters (for checkpoints)."""
+        out = {k: getattr(self, k) for k in self._STATE_SCALARS}
+        out["resultant"] = self._resultant.to_numpy()
+        if self._arrays:
+            for k in ("hist_n", "hist_xi", "hist_count"):
+                out[k] = self._arrays[k].to_numpy()
+        return out
+
+    def invalidate(self) -> None:
+        """Rebuild the candidate lists at the next evaluation (after the scene's arrays were reset)."""
+        self._need_rebuild = True
+
+    def restore_state(self, scene: Scene, state: dict) -> None:
+        """Continue from a :meth:`state` taken with the same wheel on ``scene``'s particles."""
+        for k in self._STATE_SCALARS:
+            setattr(self, k, int(state[k]))
+        self._resultant.from_numpy(np.asarray(state["resultant"], float))
+        if "hist_count" in state:
+            self._attach(scene)
+            for k in ("hist_n", "hist_xi", "hist_count"):
+                if tuple(np.shape(state[k])[:1]) != (scene.n_particles,):
+                    raise WheelsoilInputError(f"the saved contact history {k!r} is for another number of particles")
+                self._arrays[k].from_numpy(np.ascontiguousarray(state[k]))
+        self._need_rebuild = True
+
     def nodal_forces(self) -> np.ndarray:
         """Contact forces [N] on every structure node at the last evaluation, (N, 3)."""
         return self.structure.device_arrays()["f_ext"].to_numpy()

@@ -286,6 +286,8 @@ class Testbed:
         self.steps_per_sample = max(1, int(round(spec.sample_interval / self.dt)))
         self.structure.drive_hub(velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                                  free_translation=(False, False, False), free_rotation=(False, False, False))
+        self._loop: dict | None = None
+        self.rows: dict | None = None
 
     # ------------------------------------------------------------------ the run
     def _drive(self, omega: float) -> None:
@@ -304,14 +306,25 @@ class Testbed:
         push = -(self.spec.load - self.wheel_mass * self.gravity) - self.axle_damping * vertical_speed
         self.structure.drive_hub(force=(0.0, 0.0, push))
 
-    def run(self, *, progress: bool = False) -> TestbedResult:
-        """Run the protocol (lower, settle, drive); returns the time series and the steady-state summary."""
+    def run(self, *, progress: bool = False, on_sample=None) -> TestbedResult:
+        """Run the protocol (lower, settle, drive); returns the time series and the steady-state summary.
+
+        ``on_sample(testbed)``, if given, is called after every sample (the rows so far are in
+        :attr:`rows`); a run restored with :meth:`restore_state` continues where its checkpoint was taken.
+        """
         s = self.spec
         sample = self.steps_per_sample * self.dt
-        rows = {k: [] for k in SERIES_UNITS}
+        if self._loop is None:
+            self._loop = {"phase": "lower", "t_drive": math.inf, "t_settled": math.inf, "wall": 0.0}
+            self.rows = {k: [] for k in SERIES_UNITS}
+            self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
+            self.contact.mean_resultant(reset=True)
+        loop, rows = self._loop, self.rows
+        if loop["phase"] == "done":
+            raise WheelsoilInputError("this testbed has finished its run; build a new Testbed to run again")
         surface = self.bed.surface_height
         max_sinkage = 0.5 * self.wheel.radius
-        wall = time.perf_counter()
+        wall = time.perf_counter() - loop["wall"]
         bar = task = None
         if progress:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -319,15 +332,16 @@ class Testbed:
             bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
                            TimeElapsedColumn(), TimeRemainingColumn(), transient=True)
             bar.start()
-            task = bar.add_task("testbed", total=None)
-        phase, t_drive = "lower", math.inf
-        self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
-        self.contact.mean_resultant(reset=True)
+            total = None
+            if loop["phase"] != "lower":
+                total = int(math.ceil((loop["t_settled"] + s.drive_time - self.scene.time) / sample)) + len(rows["t"])
+            task = bar.add_task("testbed", total=total, completed=len(rows["t"]))
         try:
             while True:
+                phase = loop["phase"]
                 t = self.scene.time
                 if phase == "drive":
-                    ramp = min(1.0, (t - t_drive) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
+                    ramp = min(1.0, (t - loop["t_drive"]) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
                     self._drive(s.angular_velocity * ramp)
                 if phase != "lower" and self.axle_damping > 0.0:
                     self._apply_load(float(self.structure.hub_velocity[2]))
@@ -354,10 +368,11 @@ class Testbed:
                 }
                 for key, val in row.items():
                     rows[key].append(float(val))
+                finished = False
                 if phase == "lower":
                     if force[2] >= s.load:
                         self._release()
-                        phase, t_settled = "settle", self.scene.time + s.settle_time
+                        loop["phase"], loop["t_settled"] = "settle", self.scene.time + s.settle_time
                         if bar is not None:
                             bar.update(task, total=int(math.ceil((s.settle_time + s.drive_time) / sample)) + len(rows["t"]))
                     elif row["sinkage"] > max_sinkage:
@@ -365,21 +380,63 @@ class Testbed:
                             f"the bed does not carry the load {s.load} N: the wheel sank {row['sinkage']:.3f} m "
                             f"(more than half its radius) while lowered, with the soil carrying {force[2]:.1f} N"
                         )
-                elif phase == "settle" and self.scene.time >= t_settled - 1e-12:
-                    phase, t_drive = "drive", self.scene.time
-                elif phase == "drive" and self.scene.time >= t_drive + s.drive_time - 1e-12:
-                    break
+                elif phase == "settle" and self.scene.time >= loop["t_settled"] - 1e-12:
+                    loop["phase"], loop["t_drive"] = "drive", self.scene.time
+                elif phase == "drive" and self.scene.time >= loop["t_drive"] + s.drive_time - 1e-12:
+                    finished = True
                 if bar is not None:
                     bar.update(task, advance=1, description=(
                         f"{phase:6s} t = {self.scene.time:.3f} s  DP {row['drawbar_pull']:8.1f} N  "
                         f"Fz {row['vertical_force']:8.1f} N  sinkage {1e3 * row['sinkage']:6.1f} mm"))
+                if finished:
+                    break
+                if on_sample is not None:
+                    loop["wall"] = time.perf_counter() - wall
+                    on_sample(self)
         finally:
             if bar is not None:
                 bar.stop()
         self.scene.check_health()
         self.structure.check_health()
-        self.phase_times = {"released": t_settled - s.settle_time, "drive_start": t_drive}
+        loop["phase"] = "done"
+        self.phase_times = {"released": loop["t_settled"] - s.settle_time, "drive_start": loop["t_drive"]}
         return self._result({k: np.asarray(v) for k, v in rows.items()}, time.perf_counter() - wall)
+
+    # ------------------------------------------------------------------ checkpoints
+    @property
+    def samples_taken(self) -> int:
+        return len(self.rows["t"]) if self.rows else 0
+
+    @property
+    def phase(self) -> str:
+        """Where the protocol is: 'new', 'lower', 'settle', 'drive' or 'done'."""
+        return self._loop["phase"] if self._loop else "new"
+
+    def state(self) -> dict:
+        """The whole state of a run between two samples: NumPy arrays and scalars, enough to continue it.
+
+        Taking a state also puts the soil in a canonical form (its arrays go back to the host and the
+        neighbour lists are rebuilt at the next step; the wheel contact rebuilds its candidates), so a
+        run continued from a restored state steps exactly as the run that took the state does.
+        """
+        if self._loop is None or self._loop["phase"] == "done":
+            raise WheelsoilInputError("a testbed state can only be taken during a run (from on_sample)")
+        state = {"scene": self.scene.state(), "structure": self.structure.state(), "contact": self.contact.state()}
+        self.contact.invalidate()
+        loop = dict(self._loop)
+        state["testbed"] = {"loop": loop, "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
+        return state
+
+    def restore_state(self, state: dict) -> None:
+        """Continue from a :meth:`state` of a run of the same bed, wheel and rig settings."""
+        rows = state["testbed"]["rows"]
+        if set(rows) != set(SERIES_UNITS):
+            raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
+        self.scene.restore_state(state["scene"])
+        self.structure.restore_state(state["structure"])
+        self.contact.restore_state(self.scene, state["contact"])
+        self._loop = dict(state["testbed"]["loop"])
+        self.rows = {k: [float(v) for v in np.asarray(rows[k])] for k in SERIES_UNITS}
 
     def _result(self, rows: dict, wall: float) -> TestbedResult:
         s = self.spec

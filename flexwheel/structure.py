@@ -308,6 +308,26 @@ class Structure:
             self.check_health()
         return n_sub
 
+    #: Device arrays that change while the structure moves (the rest is set up once from the mesh).
+    DYNAMIC_ARRAYS = ("x", "v", "rot", "w", "f_ext", "k_ext", "x_anchor", "m_ext", "f_tot", "m_tot", "slot_f",
+                      "slot_m", "peak", "plane", "contact", "hub", "hub_rot", "hub_scalar")
+
+    def state(self) -> dict:
+        """Node and hub state, held loads and the clock as NumPy arrays and scalars (for checkpoints)."""
+        out = {k: self._dev[k].to_numpy() for k in self.DYNAMIC_ARRAYS}
+        out.update(time=self.time, steps_taken=self.steps_taken, plane_stiffness=self._plane_k)
+        return out
+
+    def restore_state(self, state: dict) -> None:
+        """Continue from a :meth:`state` of a structure built from the same mesh."""
+        for k in self.DYNAMIC_ARRAYS:
+            value = np.asarray(state[k])
+            if value.shape != self._dev[k].to_numpy().shape:
+                raise WheelsoilInputError(f"the saved wheel state {k!r} has shape {value.shape}; it belongs to another mesh")
+            self._dev[k].from_numpy(np.ascontiguousarray(value))
+        self.time, self.steps_taken = float(state["time"]), int(state["steps_taken"])
+        self._plane_k = float(state["plane_stiffness"])
+
     def check_health(self) -> None:
         """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
         worst = itg.max_speed_squared(self._dev["v"], self._dev["w"])

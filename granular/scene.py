@@ -428,6 +428,38 @@ class Scene:
             d["f"], d["t"],
         )
 
+    # ------------------------------------------------------------------ checkpoints
+    _STATE_SCALARS = ("time", "steps_taken", "neighbor_rebuilds", "_n_contacts")
+
+    def state(self) -> dict:
+        """The particle state and contact history as NumPy arrays, plus the clock (for checkpoints).
+
+        The device arrays go back to the host first, so the next step rebuilds the neighbour lists from
+        exactly this state: a scene restored from it (:meth:`restore_state`) steps bit for bit like this one.
+        """
+        self._to_host()
+        out = {"x": self._x, "v": self._v, "w": self._w, "f": self._f, "t": self._t, "r": self._r}
+        for key, value in (self._hist or {}).items():
+            out[f"hist_{key}"] = value
+        out.update({k: getattr(self, k) for k in self._STATE_SCALARS})
+        return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.items()}
+
+    def restore_state(self, state: dict) -> None:
+        """Continue from a :meth:`state` of a scene with the same spheres and walls."""
+        r = np.asarray(state["r"], float)
+        if r.shape != self._r.shape or not np.array_equal(r, self._r):
+            raise WheelsoilInputError(
+                f"the saved state has {len(r)} spheres of other radii than this scene's {self.n_particles}; "
+                "it belongs to another bed"
+            )
+        self._dev = None
+        self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
+        self._f, self._t = np.array(state["f"], float), np.array(state["t"], float)
+        hist = {k[5:]: np.array(v) for k, v in state.items() if k.startswith("hist_")}
+        self._hist = hist or None
+        for k in self._STATE_SCALARS:
+            setattr(self, k, type(getattr(self, k))(state[k]))
+
     def check_health(self) -> dict:
         """Stop with :class:`SimulationUnstableError` on NaN, escaped particles or runaway speeds.
 

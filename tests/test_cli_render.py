@@ -36,9 +36,9 @@ def test_cli_prepare_bed_and_render(tmp_path, monkeypatch):
 def test_cli_run_rejects_bad_testbed_input(tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["run", "--slip", "1.5", "--out", str(out)]) == EXIT_INPUT
-    assert "testbed slip = 1.5 is out of range: allowed -1 <= slip < 1" in capsys.readouterr().err
+    assert "test.slip = 1.5: Input should be less than 1 (allowed slip >= -1 and < 1)" in capsys.readouterr().err
     assert main(["testbed", "no-such-case", "--out", str(out)]) == EXIT_INPUT
-    assert "unknown testbed case 'no-such-case'" in capsys.readouterr().err
+    assert "no-such-case: no case file or preset of that name; presets: mini-1g-steer" in capsys.readouterr().err
     assert main(["run", "smoke-moon-steer", "--load", "0", "--out", str(out)]) == EXIT_INPUT
     assert not out.exists()
 

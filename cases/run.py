@@ -1,0 +1,208 @@
+"""One testbed run from a case: bed, wheel, rig, result file, checkpoints, plots and the render.
+
+:func:`run_case` is what ``wheelsoil run`` and every sweep worker call. A run folder holds::
+
+    result.h5, result.xdmf   the result (cases.results) and its ParaView sidecar
+    series.csv               the time series, units in the column names
+    summary.json             steady-state means, run figures, provenance, the case hash
+    case.toml                the resolved case (every key), runnable as is
+    series.png, final.png    the series plot and a render of the last state
+
+While running, ``.result.h5.partial`` collects frames and ``.checkpoint.h5`` the latest state; a run
+killed after a checkpoint continues with ``resume=True`` (``--resume``) and ends with the same result
+as a run that was never interrupted (bit for bit on the same machine and backend).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.provenance import atomic_output, provenance
+
+from .results import ResultWriter, partial_path, rigid_deflection
+from .schema import CaseFile, case_to_toml
+
+RESULT_NAME = "result.h5"
+CHECKPOINT_NAME = ".checkpoint.h5"
+
+
+@dataclass
+class RunOutcome:
+    """What a run wrote: the folder, the result file and the in-memory testbed result."""
+
+    out: Path
+    result_path: Path
+    testbed_result: object
+    resumed_from: float | None = None
+
+
+# -------------------------------------------------------------------- checkpoint files
+def _write_tree(group: h5py.Group, tree: dict) -> None:
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            _write_tree(group.create_group(key), value)
+        elif isinstance(value, np.ndarray):
+            group.create_dataset(key, data=value)
+        else:
+            group.attrs[key] = value
+
+
+def _read_tree(group: h5py.Group) -> dict:
+    out = {k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
+           for k, v in group.attrs.items()}
+    for key, item in group.items():
+        out[key] = _read_tree(item) if isinstance(item, h5py.Group) else item[()]
+    return out
+
+
+def save_checkpoint(path: Path, state: dict, meta: dict) -> None:
+    """Write a testbed state (nested dict of arrays and scalars) and ``meta`` atomically."""
+    with atomic_output(path) as tmp:
+        with h5py.File(tmp, "w") as f:
+            _write_tree(f.create_group("state"), state)
+            for key, value in meta.items():
+                f.attrs[key] = value
+
+
+def load_checkpoint(path: Path) -> tuple[dict, dict]:
+    """(state, meta) of a checkpoint file."""
+    with h5py.File(path, "r") as f:
+        state = _read_tree(f["state"])
+        meta = {k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
+                for k, v in f.attrs.items()}
+    return state, meta
+
+
+# -------------------------------------------------------------------- the run
+def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume: bool = False,
+             progress: bool = False, console=None, bed_cache: str | Path | None = None) -> RunOutcome:
+    """Run ``case`` and write its folder ``out`` (see the module docstring).
+
+    ``resume``: continue from ``out``'s checkpoint (an error names what is missing or different).
+    ``bed_cache``: the bed cache folder (default ``WHEELSOIL_CACHE`` or ``~/.cache/wheelsoil``).
+    Raises :class:`~wheelsoil.errors.WheelsoilInputError` for bad input and
+    :class:`~wheelsoil.errors.SimulationUnstableError` when the run blows up; a run that fails after
+    a checkpoint keeps its partial files, so that ``resume=True`` can continue it.
+    """
+    from wheelsoil.coupling.testbed import SERIES_UNITS, Testbed
+    from wheelsoil.granular import prepare_bed
+
+    say = console.print if console is not None else (lambda *a, **k: None)
+    out = Path(out)
+    result_path = out / RESULT_NAME
+    ckpt_path = out / CHECKPOINT_NAME
+    case_hash = case.case_hash()
+    ckpt_state = None
+    if resume:
+        if not ckpt_path.is_file():
+            raise WheelsoilInputError(f"nothing to resume in {out}: no checkpoint ({CHECKPOINT_NAME}); "
+                                      "run without --resume")
+        ckpt_state, meta = load_checkpoint(ckpt_path)
+        if meta.get("case_hash") != case_hash:
+            raise WheelsoilInputError(
+                f"the checkpoint in {out} is of another case (hash {meta.get('case_hash')}, this case {case_hash}); "
+                "resume with the same case file and --set overrides, or run without --resume")
+    else:
+        ckpt_path.unlink(missing_ok=True)
+        partial_path(result_path).unlink(missing_ok=True)
+
+    bed = prepare_bed(case.bed_spec(), cache_dir=bed_cache, progress=progress, arch=arch)
+    say(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
+    bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
+    spec = case.testbed_spec()
+    say(f"wheel {case.wheel.preset}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
+        f"{'rigid' if spec.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; slip {spec.slip:g}, "
+        f"steering {spec.slip_angle:g} deg, W = {spec.load:g} N")
+
+    prov = provenance()
+    attrs = {"case_toml": case_to_toml(case), "case_name": case.name, "case_hash": case_hash,
+             "seed": case.case.seed, "bed": bed.summary(), **prov}
+    nodes0 = bench.mesh.nodes.copy()
+    hub0 = bench.structure.hub_position
+    mesh = {"nodes0": nodes0, "triangles": bench.mesh.triangles, "beams": bench.mesh.beams.reshape(-1, 2)}
+    frame_dt, ckpt_dt = case.output.frame_interval, case.output.checkpoint_interval
+    counters = {"frames": 0, "checkpoints": 0}
+    resumed_from = None
+    if ckpt_state is not None:
+        counters["frames"], counters["checkpoints"] = int(meta["frames"]), int(meta["checkpoints"])
+        bench.restore_state(ckpt_state)
+        resumed_from = float(bench.scene.time)
+        say(f"resuming from the checkpoint at t = {resumed_from:.3f} s ({counters['frames']} frames kept)")
+    writer = ResultWriter(result_path, attrs, mesh, resume_frames=counters["frames"] if resume else None)
+
+    def add_frame(tb) -> None:
+        nodes = tb.structure.positions()
+        writer.add_frame(tb.scene.time, {"position": tb.scene.positions, "velocity": tb.scene.velocities,
+                                         "radius": tb.scene.radii}, nodes,
+                         rigid_deflection(nodes, nodes0, tb.structure.hub_position, hub0, tb.structure.hub_rotation))
+        counters["frames"] += 1
+
+    def on_sample(tb) -> None:
+        t = tb.scene.time
+        if frame_dt > 0 and t >= (counters["frames"] + 1) * frame_dt - 1e-12:
+            add_frame(tb)
+        if ckpt_dt > 0 and t >= (counters["checkpoints"] + 1) * ckpt_dt - 1e-12:
+            counters["checkpoints"] = int(math.floor(t / ckpt_dt + 1e-9))
+            writer.flush()
+            save_checkpoint(ckpt_path, tb.state(), {"case_hash": case_hash, "frames": counters["frames"],
+                                                    "checkpoints": counters["checkpoints"], "t": t})
+
+    try:
+        result = bench.run(progress=progress, on_sample=on_sample)
+        add_frame(bench)
+    except BaseException:
+        writer.abandon()
+        if not ckpt_path.is_file():
+            partial_path(result_path).unlink(missing_ok=True)
+        raise
+    info = dict(result.info)
+    if resumed_from is not None:
+        info["resumed_from"] = resumed_from
+    writer.finish(result.series, SERIES_UNITS, result.summary, info)
+    ckpt_path.unlink(missing_ok=True)
+    write_run_folder(out, case, result, prov)
+    return RunOutcome(out=out, result_path=result_path, testbed_result=result, resumed_from=resumed_from)
+
+
+def write_run_folder(out: Path, case: CaseFile, result, prov: dict) -> list[Path]:
+    """series.csv, summary.json, case.toml, series.png and (if the case asks) final.png."""
+    from wheelsoil.coupling.testbed import SERIES_UNITS
+
+    names = list(SERIES_UNITS)
+    rows = [",".join(f"{n}[{SERIES_UNITS[n]}]" for n in names)]
+    rows += [",".join(f"{result.series[n][k]:.9g}" for n in names) for k in range(len(result.series["t"]))]
+    written = []
+    with atomic_output(out / "series.csv") as tmp:
+        tmp.write_text("\n".join(rows) + "\n")
+    written.append(out / "series.csv")
+    summary = {"case": case.name, "case_hash": case.case_hash(), "summary": result.summary, "run": result.info,
+               "testbed": result.spec.to_dict(), "bed": result.bed_summary, "provenance": prov}
+    with atomic_output(out / "summary.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2, default=str))
+    written.append(out / "summary.json")
+    with atomic_output(out / "case.toml") as tmp:
+        tmp.write_text(case_to_toml(case))
+    written.append(out / "case.toml")
+    from .plots import plot_series
+
+    written.append(plot_series(result, out / "series.png", case.name))
+    if case.output.render:
+        from .render import render_testbed
+
+        with atomic_output(out / "final.png") as tmp:
+            image = tmp.with_suffix(".png")  # the renderer picks the format from the suffix
+            try:
+                render_testbed(result, image, title=f"{case.name}: end of the run")
+                os.replace(image, tmp)
+            finally:
+                image.unlink(missing_ok=True)
+        written.append(out / "final.png")
+    return written

@@ -1,0 +1,475 @@
+"""The case file: a TOML description of one testbed run, validated by a pydantic schema.
+
+A case has six sections; every key has a default (the smoke steering run), so a case file holds
+only what differs from it. ``wheelsoil case show`` prints every key with its unit, range and default.
+
+    [case]      name, description, seed of the bed's random packing
+    [soil]      bin size, particle sizes, gravity, particle material and soil--soil friction
+    [wheel]     a preset wheel (lunar-rover, exomars), its mesh size, rigid or flexible, any dimension
+    [contact]   soil--wheel restitution and friction
+    [test]      what the rig does: slip, steering angle, load, wheel speed, timing
+    [output]    sampling, steady-state detection, frames kept in the result, checkpoints, the render
+
+Values are SI numbers in the key's unit (angles in degrees), or strings with a unit of the same
+dimension ("600 ms", "3 kN", "30 %"; :mod:`wheelsoil.cases.units`). Errors name the file, the key,
+the value and what is allowed; an unknown key is answered with the closest valid one.
+
+A case plus ``--set section.key=value`` overrides is the whole input of a run; the resolved case
+(every key, defaults filled in) is what a result file stores (:func:`case_to_toml`) and its hash
+(:meth:`CaseFile.case_hash`) keys finished runs in a sweep.
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import math
+import sys
+from importlib import resources
+from pathlib import Path
+from typing import Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
+
+from wheelsoil.errors import WheelsoilInputError
+
+from .units import UnitError, to_unit
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+EARTH_GRAVITY = 9.81
+GRAVITY_PRESETS = {"earth": EARTH_GRAVITY, "moon": EARTH_GRAVITY / 6.0}
+
+
+class CaseError(WheelsoilInputError):
+    """A case file (or override) that does not validate; ``problems`` lists one line per error."""
+
+    def __init__(self, source: str, problems: list[str]) -> None:
+        self.source, self.problems = source, list(problems)
+        head = f"{source}: " if len(problems) == 1 else f"{source}: {len(problems)} problems:\n  "
+        super().__init__(head + "\n  ".join(problems))
+
+
+def _q(default, unit: str, description: str, **limits):
+    """A field with a unit (documented and converted from strings) and range limits."""
+    return Field(default, description=description, json_schema_extra={"unit": unit}, **limits)
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _convert_units(cls, value, info: ValidationInfo):
+        extra = cls.model_fields[info.field_name].json_schema_extra or {}
+        unit = extra.get("unit")
+        if unit and isinstance(value, str):
+            try:
+                return to_unit(value, unit)
+            except UnitError as exc:
+                raise ValueError(str(exc)) from None
+        return value
+
+
+class CaseInfo(_Section):
+    name: Optional[str] = Field(None, description="run name (default: the file name without .toml)",
+                                min_length=1, max_length=120, pattern=r"^[A-Za-z0-9._+-]+$")
+    description: str = Field("", description="free text kept with the result")
+    seed: int = Field(0, ge=0, description="random seed of the bed's particle radii and packing")
+
+
+class Soil(_Section):
+    length: float = _q(2.0, "m", "bin length along the travel direction", gt=0)
+    width: float = _q(0.9, "m", "bin width across the travel direction", gt=0)
+    depth: float = _q(0.2, "m", "levelled bed depth", gt=0)
+    diameter_min: float = _q(0.025, "m", "smallest particle diameter (uniform distribution)", gt=0)
+    diameter_max: float = _q(0.0375, "m", "largest particle diameter", gt=0)
+    gravity: Union[float, tuple[float, float, float], str] = Field(
+        "earth", description="'earth' (9.81 m/s^2), 'moon' (9.81/6), a magnitude in m/s^2, or a vector "
+                             "[gx, gy, gz] with gz < 0; the bed is prepared under the gravity it is tested at")
+    youngs_modulus: float = _q(50e6, "Pa", "particle Young's modulus (seed 004 Table 1)", gt=0)
+    poisson_ratio: float = _q(0.3, "1", "particle Poisson's ratio", gt=-1, lt=0.5)
+    density: float = _q(3200.0, "kg/m^3", "particle density", gt=0)
+    restitution: float = _q(0.5, "1", "soil--soil coefficient of restitution", gt=0, le=1)
+    static_friction: float = _q(0.42, "1", "soil--soil Coulomb friction coefficient", ge=0)
+    rolling_friction: float = _q(0.11, "1", "soil--soil rolling friction coefficient", ge=0)
+    time_step: Optional[float] = _q(None, "s", "DEM time step (default: the stable Hertz/Rayleigh estimate)", gt=0)
+    max_settle_time: float = _q(10.0, "s", "give up preparing the bed after this much settling", gt=0)
+
+    @field_validator("gravity")
+    @classmethod
+    def _gravity(cls, value):
+        if isinstance(value, str):
+            if value not in GRAVITY_PRESETS:
+                raise ValueError("gravity is 'earth', 'moon', a magnitude in m/s^2 or a vector [gx, gy, gz]")
+            return value
+        if isinstance(value, (int, float)):
+            if not (math.isfinite(value) and 0 < value < 1000):
+                raise ValueError("a gravity magnitude must lie in (0, 1000) m/s^2")
+            return float(value)
+        if not all(math.isfinite(v) for v in value) or value[2] >= 0:
+            raise ValueError("a gravity vector must be finite and point down (gz < 0)")
+        return tuple(float(v) for v in value)
+
+    @property
+    def gravity_vector(self) -> tuple[float, float, float]:
+        g = self.gravity
+        if isinstance(g, str):
+            return (0.0, 0.0, -GRAVITY_PRESETS[g])
+        if isinstance(g, float):
+            return (0.0, 0.0, -g)
+        return tuple(g)
+
+
+WHEEL_PRESETS = ("lunar-rover", "exomars")
+
+
+class Wheel(_Section):
+    preset: Literal["lunar-rover", "exomars"] = Field(
+        "lunar-rover", description="base wheel: lunar-rover (seed 004, r = 0.6 m) or exomars (seeds 000/001); "
+                                   "the keys below replace its dimensions")
+    element_size: Optional[float] = _q(0.05, "m", "target element edge of the mesh (preset's own: 0.018 m "
+                                                  "lunar-rover, 0.006 m exomars)", gt=0)
+    rigid: bool = Field(False, description="use the rigid wheel with the same surface")
+    damping: float = _q(10.0, "1/s", "mass-proportional structural damping, relative to the hub", ge=0)
+    radius: Optional[float] = _q(None, "m", "outer tread radius (without grousers)", gt=0)
+    width: Optional[float] = _q(None, "m", "tread width", gt=0)
+    tread_thickness: Optional[float] = _q(None, "m", "tread sheet thickness", gt=0)
+    hub_radius: Optional[float] = _q(None, "m", "hub radius", gt=0)
+    spokes_per_row: Optional[int] = Field(None, ge=1, description="spokes in each spoke row")
+    spoke_thickness: Optional[float] = _q(None, "m", "spoke sheet thickness", gt=0)
+    spoke_bow: Optional[float] = _q(None, "1", "spoke bow as a fraction of its length", ge=0, le=0.5)
+    spoke_model: Optional[Literal["shell", "beam"]] = Field(None, description="spokes as shells or beams")
+    spoke_rows: Optional[list[tuple[float, float, float]]] = Field(
+        None, description="spoke rows as [y_min, y_max, angle]: band of the width (fractions, -0.5..0.5) "
+                          "and angle of the first spoke [deg]")
+    grouser_count: Optional[int] = Field(None, ge=0, description="grousers around the tread (0: smooth)")
+    grouser_height: Optional[float] = _q(None, "m", "grouser height", ge=0)
+    grouser_thickness: Optional[float] = _q(None, "m", "grouser sheet thickness", ge=0)
+    grouser_angle: Optional[float] = _q(None, "deg", "grouser angle to the axle (chevron half-angle)")
+    hub_mass: Optional[float] = _q(None, "kg", "hub mass (with the rig's moving parts)", ge=0)
+    youngs_modulus: Optional[float] = _q(None, "Pa", "wheel material Young's modulus", gt=0)
+    poisson_ratio: Optional[float] = _q(None, "1", "wheel material Poisson's ratio", gt=-1, lt=0.5)
+    density: Optional[float] = _q(None, "kg/m^3", "wheel material density", gt=0)
+
+
+class Contact(_Section):
+    restitution: float = _q(0.5, "1", "soil--wheel coefficient of restitution (seed 004 soil--steel)", gt=0, le=1)
+    static_friction: float = _q(0.39, "1", "soil--wheel Coulomb friction coefficient", ge=0)
+    rolling_friction: float = _q(0.15, "1", "soil--wheel rolling friction coefficient", ge=0)
+
+
+class Test(_Section):
+    __test__ = False  # not a pytest class
+
+    slip: float = _q(0.3, "1", "longitudinal slip i = 1 - v_x / (r omega) (negative: braking)", ge=-1, lt=1)
+    slip_angle: float = _q(10.0, "deg", "steering (slip) angle beta between heading and travel", gt=-90, lt=90)
+    load: float = _q(3000.0, "N", "vertical load W on the soil, wheel weight included", gt=0)
+    angular_velocity: float = _q(1.0, "rad/s", "wheel spin omega", gt=0)
+    lowering_speed: float = _q(0.3, "m/s", "speed at which the rig lowers the wheel until the soil carries W", gt=0)
+    settle_time: float = _q(0.1, "s", "rest, free vertically under W, before driving", gt=0)
+    spin_up_time: float = _q(0.05, "s", "time over which omega and the carriage speed ramp up", ge=0)
+    drive_time: float = _q(0.6, "s", "time driven at constant omega", gt=0)
+    start_x: Optional[float] = _q(None, "m", "initial hub position along the bin (default: radius + 0.1 m)", gt=0)
+    axle_damping: Optional[float] = _q(None, "N s/m", "damper on the rig's vertical slide (default: wheel "
+                                                      "mass / 0.1 s)", ge=0)
+
+
+class Output(_Section):
+    sample_interval: float = _q(0.005, "s", "averaging interval of one time-series sample", gt=0)
+    steady_window: float = _q(0.15, "s", "shortest span compared when detecting the steady state", gt=0)
+    steady_tolerance: float = _q(0.15, "1", "relative change allowed between the halves of the steady span", gt=0)
+    frame_interval: float = _q(0.05, "s", "simulated time between frames (particles, wheel nodes) kept in the "
+                                          "result; 0: the last frame only", ge=0)
+    checkpoint_interval: float = _q(0.25, "s", "simulated time between checkpoints a killed run resumes from "
+                                               "(--resume); 0: none", ge=0)
+    render: bool = Field(True, description="render the last state to final.png")
+
+
+SECTIONS: dict[str, type[_Section]] = {
+    "case": CaseInfo, "soil": Soil, "wheel": Wheel, "contact": Contact, "test": Test, "output": Output,
+}
+
+
+class CaseFile(BaseModel):
+    """A validated case: one testbed run."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    case: CaseInfo = Field(default_factory=CaseInfo)
+    soil: Soil = Field(default_factory=Soil)
+    wheel: Wheel = Field(default_factory=Wheel)
+    contact: Contact = Field(default_factory=Contact)
+    test: Test = Field(default_factory=Test)
+    output: Output = Field(default_factory=Output)
+
+    @property
+    def name(self) -> str:
+        return self.case.name or "case"
+
+    def case_hash(self) -> str:
+        """16 hex digits of SHA-256 over everything that shapes the result (not the name or description)."""
+        data = self.model_dump(mode="json")
+        data["case"].pop("name")
+        data["case"].pop("description")
+        return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+
+    # ---------------------------------------------------------------- the solver's objects
+    def bed_spec(self):
+        """The :class:`~wheelsoil.granular.BedSpec` of the soil section."""
+        from wheelsoil.granular.bed import BedSpec
+        from wheelsoil.granular.materials import Material, PairProperties
+
+        s = self.soil
+        return BedSpec(
+            length=s.length, width=s.width, depth=s.depth, diameter_min=s.diameter_min,
+            diameter_max=s.diameter_max, gravity=s.gravity_vector,
+            material=Material("lunar soil simulant", s.youngs_modulus, s.poisson_ratio, s.density),
+            pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
+            seed=self.case.seed, max_settle_time=s.max_settle_time, time_step=s.time_step,
+        )
+
+    def wheel_geometry(self):
+        """The :class:`~wheelsoil.flexwheel.geometry.WheelGeometry` of the wheel section."""
+        from dataclasses import replace
+
+        from wheelsoil.flexwheel.geometry import SpokeRow, preset
+        from wheelsoil.flexwheel.material import ElasticMaterial
+
+        w = self.wheel
+        base = preset(w.preset)
+        changes = {k: getattr(w, k) for k in (
+            "element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
+            "spoke_bow", "spoke_model", "grouser_count", "grouser_height", "grouser_thickness", "grouser_angle",
+            "hub_mass") if getattr(w, k) is not None}
+        if w.spoke_rows is not None:
+            changes["spoke_rows"] = tuple(SpokeRow(*row) for row in w.spoke_rows)
+        if any(v is not None for v in (w.youngs_modulus, w.poisson_ratio, w.density)):
+            m = base.material
+            changes["material"] = ElasticMaterial(
+                w.youngs_modulus if w.youngs_modulus is not None else m.youngs_modulus,
+                w.poisson_ratio if w.poisson_ratio is not None else m.poisson_ratio,
+                w.density if w.density is not None else m.density, name=f"{base.name} material (case)")
+        return replace(base, **changes)
+
+    def testbed_spec(self):
+        """The :class:`~wheelsoil.coupling.testbed.TestbedSpec` of the test, contact and output sections."""
+        from wheelsoil.coupling.testbed import TestbedSpec
+        from wheelsoil.granular.materials import PairProperties
+
+        t, o, c = self.test, self.output, self.contact
+        return TestbedSpec(
+            slip=t.slip, slip_angle=t.slip_angle, load=t.load, angular_velocity=t.angular_velocity,
+            lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
+            drive_time=t.drive_time, sample_interval=o.sample_interval, steady_window=o.steady_window,
+            steady_tolerance=o.steady_tolerance, start_x=t.start_x, rigid=self.wheel.rigid, damping=self.wheel.damping,
+            axle_damping=t.axle_damping, pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
+        )
+
+
+# -------------------------------------------------------------------- reading
+def preset_names() -> list[str]:
+    """Names of the case presets shipped in ``wheelsoil/cases/presets``."""
+    folder = resources.files("wheelsoil.cases") / "presets"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def preset_text(name: str) -> str:
+    """The TOML text of a preset case."""
+    path = resources.files("wheelsoil.cases") / "presets" / f"{name}.toml"
+    if not path.is_file():
+        raise CaseError(name, [f"no case file or preset of that name; presets: {', '.join(preset_names())}"])
+    return path.read_text()
+
+
+def parse_toml(text: str, source: str) -> dict:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError(source, [f"not valid TOML: {exc}"]) from None
+
+
+def _suggest(word: str, options, prefix: str = "") -> str:
+    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
+    return f"; did you mean {prefix}{close[0]}?" if close else f"; valid keys: {', '.join(options)}"
+
+
+def _lookup(data: dict, loc: tuple):
+    for part in loc:
+        if isinstance(data, dict) and part in data:
+            data = data[part]
+        elif isinstance(data, (list, tuple)) and isinstance(part, int) and part < len(data):
+            data = data[part]
+        else:
+            return None
+    return data
+
+
+def _limits(section: str, key: str, *, with_unit: bool = True) -> str:
+    model = SECTIONS.get(section)
+    field = model.model_fields.get(key) if model else None
+    if field is None:
+        return ""
+    words = {"Gt": ">", "Ge": ">=", "Lt": "<", "Le": "<="}
+    parts = []
+    for meta in field.metadata:
+        for attr, sym in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
+            bound = getattr(meta, attr, None)
+            if bound is not None and type(meta).__name__ in words:
+                parts.append(f"{sym} {bound:g}")
+    unit = (field.json_schema_extra or {}).get("unit")
+    text = f"allowed {key} {' and '.join(parts)}" if parts else ""
+    if with_unit and unit and unit != "1":
+        text += f"{'; ' if text else ''}unit {unit}"
+    return f" ({text})" if text else ""
+
+
+def _messages(exc: ValidationError, data: dict) -> list[str]:
+    out = []
+    for err in exc.errors():
+        loc = tuple(err["loc"])
+        # a union's alternatives add their type name to the location; keep the key path only
+        path = [p for p in loc if not (isinstance(p, str) and p.endswith("]") or p in ("str", "float", "int"))]
+        key = ".".join(str(p) for p in path)
+        if err["type"] == "extra_forbidden":
+            if len(path) == 1:
+                out.append(f"unknown section [{path[0]}]{_suggest(str(path[0]), SECTIONS)}")
+            else:
+                model = SECTIONS.get(str(path[0]))
+                options = list(model.model_fields) if model else []
+                out.append(f"unknown key {key}{_suggest(str(path[-1]), options, f'{path[0]}.')}")
+            continue
+        value = _lookup(data, tuple(path))
+        limits = _limits(str(path[0]), str(path[1])) if len(path) >= 2 else ""
+        msg = err["msg"].removeprefix("Value error, ")
+        out.append(f"{key} = {value!r}: {msg}{limits}")
+    # a union reports every alternative; one line per key is enough
+    seen, unique = set(), []
+    for line in out:
+        head = line.split(":")[0]
+        if head not in seen:
+            seen.add(head)
+            unique.append(line)
+    return unique
+
+
+def validate_case(data: dict, source: str, *, default_name: str | None = None) -> CaseFile:
+    """Validate a case dictionary (parsed TOML); errors name ``source``, the key and the value."""
+    if not isinstance(data, dict):
+        raise CaseError(source, ["a case is a TOML table of sections"])
+    try:
+        case = CaseFile.model_validate(data)
+    except ValidationError as exc:
+        raise CaseError(source, _messages(exc, data)) from None
+    if case.case.name is None:
+        name = default_name or "case"
+        case = case.model_copy(update={"case": case.case.model_copy(update={"name": name})})
+    try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, ...)
+        case.bed_spec()
+        case.wheel_geometry()
+        case.testbed_spec()
+    except WheelsoilInputError as exc:
+        raise CaseError(source, [str(exc)]) from None
+    return case
+
+
+def parse_override(text: str) -> tuple[list[str], object]:
+    """``section.key=value`` -> (["section", "key"], value); the value is read as TOML (``0.3``,
+    ``true``, ``[0, 0, -1.62]``, ``"3 kN"``), or taken as a string when it is not TOML (``moon``)."""
+    if "=" not in text:
+        raise CaseError("--set", [f"{text!r} is not section.key=value (e.g. test.slip=0.3)"])
+    key, raw = (s.strip() for s in text.split("=", 1))
+    path = [p for p in key.split(".") if p]
+    if len(path) != 2:
+        raise CaseError("--set", [f"{key!r} is not section.key (sections: {', '.join(SECTIONS)})"])
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return path, value
+
+
+def apply_overrides(data: dict, overrides) -> dict:
+    """A copy of ``data`` with each ``section.key=value`` override (or (path, value) pair) set."""
+    data = json.loads(json.dumps(data))  # deep copy of plain TOML data
+    for item in overrides or ():
+        path, value = parse_override(item) if isinstance(item, str) else item
+        section, key = path
+        if section not in SECTIONS:
+            raise CaseError("--set", [f"unknown section {section!r} in {'.'.join(path)}{_suggest(section, SECTIONS)}"])
+        if key not in SECTIONS[section].model_fields:
+            raise CaseError("--set", [f"unknown key {'.'.join(path)}"
+                                      f"{_suggest(key, list(SECTIONS[section].model_fields), f'{section}.')}"])
+        data.setdefault(section, {})[key] = value
+    return data
+
+
+def load_case(spec: str | Path, overrides=(), *, name: str | None = None) -> CaseFile:
+    """A case from a TOML file path or a preset name, with ``section.key=value`` overrides applied.
+
+    The case name defaults to the file (or preset) name; ``name`` replaces it.
+    """
+    path = Path(spec)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise CaseError(str(path), ["no such case file"])
+        text, source, stem = path.read_text(), str(path), path.stem
+    else:
+        text, source, stem = preset_text(str(spec)), f"preset {spec}", str(spec)
+    data = apply_overrides(parse_toml(text, source), [o for o in overrides])
+    if name is not None:
+        data.setdefault("case", {})["name"] = name
+    where = source + (f" with --set {' '.join(overrides)}" if overrides else "")
+    return validate_case(data, where, default_name=stem)
+
+
+def case_from_toml(text: str, source: str = "case text") -> CaseFile:
+    """The case a resolved TOML text (as written by :func:`case_to_toml`) describes."""
+    return validate_case(parse_toml(text, source), source)
+
+
+# -------------------------------------------------------------------- writing
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf") if math.isinf(value) else "nan"
+    if isinstance(value, str):
+        return json.dumps(value)  # JSON string escapes are valid TOML basic strings
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"no TOML form for {value!r}")
+
+
+def case_to_toml(case: CaseFile, *, comments: bool = True) -> str:
+    """Every key of ``case`` as TOML (unset optional keys as comments), with units and ranges documented.
+
+    ``case_from_toml(case_to_toml(case)) == case`` (the round trip a result file relies on).
+    """
+    lines = [f"# wheelsoil case (schema of wheelsoil {_version()}); every key shown, defaults filled in"]
+    for section, model in SECTIONS.items():
+        values = getattr(case, section)
+        lines += ["", f"[{section}]"]
+        for key, field in model.model_fields.items():
+            value = getattr(values, key)
+            unit = (field.json_schema_extra or {}).get("unit")
+            note = f"  # [{unit}] {field.description}" if comments and unit else (
+                f"  # {field.description}" if comments and field.description else "")
+            note += _limits(section, key, with_unit=False).replace(f"allowed {key} ", "") if comments and note else ""
+            if value is None:
+                lines.append(f"# {key} ={note}")
+            else:
+                lines.append(f"{key} = {_toml_value(value)}{note}")
+    return "\n".join(lines) + "\n"
+
+
+def _version() -> str:
+    from wheelsoil import __version__
+
+    return __version__
