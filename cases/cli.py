@@ -155,10 +155,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=Path("bed.h5"), help="bed file to write (default bed.h5)")
     p.set_defaults(func=cmd_prepare_bed)
 
-    p = sub.add_parser("render", help="render a bed file to PNG offscreen",
-                       description="Render the particles of a bed HDF5 file to a PNG, coloured by height.")
-    p.add_argument("bed", type=Path, help="bed file written by prepare-bed or run")
-    p.add_argument("--out", type=Path, default=None, help="PNG to write (default: next to the bed file)")
+    p = sub.add_parser("render", help="render a result (a frame, or an animation) or a bed file offscreen",
+                       description="Render offscreen (no display needed). A result (result.h5 or its run folder): "
+                                   "one frame to PNG -- particles coloured by speed (or height), the wheel by its "
+                                   "deflection (displacement less the hub's rigid motion) -- or, with --animate, "
+                                   "every frame to a GIF or MP4 (the --out suffix picks; MP4 uses imageio-ffmpeg's "
+                                   "own ffmpeg). A bed file: its particles coloured by height.")
+    p.add_argument("path", type=Path, help="result.h5, a run folder, or a bed file written by prepare-bed")
+    p.add_argument("--out", type=Path, default=None,
+                   help="file to write (default: frame.png, animation.gif or <bed>.png beside the input)")
+    p.add_argument("--frame", type=int, default=-1, help="result frame to render (default -1: the last)")
+    p.add_argument("--animate", action="store_true", help="render every frame of a result to --out (.gif or .mp4)")
+    p.add_argument("--fps", type=float, default=10.0, help="animation frames per second (default 10)")
+    p.add_argument("--color", default="speed", help="particle colour: speed (default) or height")
+    p.add_argument("--wheel-color", default="deflection", help="wheel colour: deflection (default) or none")
     p.add_argument("--camera", default="iso", help="camera preset: iso, side, top, front (default iso)")
     p.add_argument("--size", type=int, nargs=2, default=(1200, 800), metavar=("W", "H"), help="image size in pixels")
     p.set_defaults(func=cmd_render)
@@ -432,16 +442,59 @@ def cmd_prepare_bed(args) -> int:
 
 
 def cmd_render(args) -> int:
-    from wheelsoil.granular import load_bed
+    import h5py
 
-    from .render import CAMERA_PRESETS, render_bed
+    from .render import CAMERA_PRESETS, PARTICLE_COLORS
 
     if args.camera not in CAMERA_PRESETS:
         raise _InputError(f"--camera {args.camera!r} is not a preset; choose one of {sorted(CAMERA_PRESETS)}")
-    bed = load_bed(args.bed)
-    out = args.out or args.bed.with_suffix(".png")
+    if args.color not in PARTICLE_COLORS:
+        raise _InputError(f"--color {args.color!r}; choose one of {sorted(PARTICLE_COLORS)}")
+    if args.wheel_color not in ("deflection", "none"):
+        raise _InputError(f"--wheel-color {args.wheel_color!r}; choose deflection or none")
+    if any(v < 16 or v > 8192 for v in args.size):
+        raise _InputError(f"--size {args.size[0]} {args.size[1]}: each side must lie in [16, 8192] pixels")
+    if not (0 < args.fps <= 120):
+        raise _InputError(f"--fps {args.fps} must lie in (0, 120]")
     console = _console()
-    console.print(f"wrote {render_bed(bed, out, camera=args.camera, size=tuple(args.size))}")
+    path = args.path / "result.h5" if args.path.is_dir() else args.path
+    is_result = False
+    if path.is_file():
+        try:
+            with h5py.File(path, "r") as f:
+                is_result = "case_toml" in f.attrs
+        except OSError:
+            raise _InputError(f"{path} is not an HDF5 file (a result or a bed)") from None
+    size = tuple(args.size)
+    if is_result:
+        from .render import render_animation, render_result_frame
+        from .results import load_result
+
+        result = load_result(path)
+        wheel = None if args.wheel_color == "none" else "deflection"
+        if args.animate:
+            out = args.out or path.parent / "animation.gif"
+            if out.suffix.lower() not in (".gif", ".mp4"):
+                raise _InputError(f"--out {out}: an animation is a .gif or .mp4 file")
+            with _progress(console) as bar:
+                task = bar.add_task("rendering frames", total=len(result.frame_times))
+                render_animation(result, out, fps=args.fps, color=args.color, wheel_color=wheel, camera=args.camera,
+                                 size=size, progress=lambda k, n: bar.update(task, completed=k))
+        else:
+            out = args.out or path.parent / "frame.png"
+            render_result_frame(result, out, frame=args.frame, color=args.color, wheel_color=wheel,
+                                camera=args.camera, size=size)
+        console.print(f"wrote {out}")
+        return EXIT_OK
+    if args.animate:
+        raise _InputError(f"--animate needs a result file; {path} is not one")
+    from wheelsoil.granular import load_bed
+
+    from .render import render_bed
+
+    bed = load_bed(path)
+    out = args.out or path.with_suffix(".png")
+    console.print(f"wrote {render_bed(bed, out, camera=args.camera, size=size)}")
     return EXIT_OK
 
 

@@ -48,13 +48,48 @@ def render_particles(
     sphere_resolution: int = 12,
     title: str | None = None,
     surface: tuple[np.ndarray, np.ndarray] | None = None,
+    surface_scalars: np.ndarray | None = None,
+    surface_scalar_name: str = "wheel deflection [mm]",
+    clim: tuple[float, float] | None = None,
+    surface_clim: tuple[float, float] | None = None,
 ) -> Path:
     """Render spheres (coloured by ``scalars``, default height) to a PNG; returns the path.
 
     ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline. ``camera`` is one of
-    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a steel-grey
-    triangulated surface (the wheel).
+    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a triangulated
+    surface (the wheel): steel grey, or coloured by the nodal ``surface_scalars``. ``clim`` and
+    ``surface_clim`` fix the colour ranges (for animations).
     """
+    image = render_image(positions, radii, scalars=scalars, scalar_name=scalar_name, box=box, camera=camera,
+                         size=size, sphere_resolution=sphere_resolution, title=title, surface=surface,
+                         surface_scalars=surface_scalars, surface_scalar_name=surface_scalar_name, clim=clim,
+                         surface_clim=surface_clim)
+    import imageio.v3 as iio
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    iio.imwrite(path, image, extension=".png")
+    return path
+
+
+def render_image(
+    positions: np.ndarray,
+    radii: np.ndarray,
+    *,
+    scalars: np.ndarray | None = None,
+    scalar_name: str = "height [m]",
+    box: tuple | None = None,
+    camera: str = "iso",
+    size: tuple[int, int] = (1200, 800),
+    sphere_resolution: int = 12,
+    title: str | None = None,
+    surface: tuple[np.ndarray, np.ndarray] | None = None,
+    surface_scalars: np.ndarray | None = None,
+    surface_scalar_name: str = "wheel deflection [mm]",
+    clim: tuple[float, float] | None = None,
+    surface_clim: tuple[float, float] | None = None,
+) -> np.ndarray:
+    """The image of :func:`render_particles` as an (H, W, 3) uint8 array."""
     import pyvista as pv
 
     if camera not in CAMERA_PRESETS:
@@ -71,13 +106,21 @@ def render_particles(
     )
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
-    plotter.add_mesh(glyphs, scalars=scalar_name, cmap="viridis", smooth_shading=True,
-                     scalar_bar_args={"title": scalar_name, "color": "black"})
+    plotter.add_mesh(glyphs, scalars=scalar_name, cmap="viridis", smooth_shading=True, clim=clim,
+                     scalar_bar_args={"title": scalar_name, "color": "black", "position_x": 0.05, "width": 0.4})
     if surface is not None:
         nodes, tris = np.asarray(surface[0], float), np.asarray(surface[1], np.int64)
         faces = np.hstack([np.full((len(tris), 1), 3, np.int64), tris]).ravel()
-        plotter.add_mesh(pv.PolyData(nodes, faces), color="#9aa3ad", smooth_shading=False, show_edges=True,
-                         edge_color="#5b6168", line_width=0.5)
+        wheel = pv.PolyData(nodes, faces)
+        if surface_scalars is None:
+            plotter.add_mesh(wheel, color="#9aa3ad", smooth_shading=False, show_edges=True, edge_color="#5b6168",
+                             line_width=0.5)
+        else:
+            wheel[surface_scalar_name] = np.asarray(surface_scalars, float)
+            plotter.add_mesh(wheel, scalars=surface_scalar_name, cmap="inferno", show_edges=True,
+                             edge_color="#5b6168", line_width=0.3, clim=surface_clim,
+                             scalar_bar_args={"title": surface_scalar_name, "color": "black", "vertical": True,
+                                              "position_x": 0.88, "position_y": 0.3, "height": 0.5, "width": 0.06})
     if box is not None:
         lo, hi = np.asarray(box[0], float), np.asarray(box[1], float)
         plotter.add_mesh(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).outline(), color="black",
@@ -89,11 +132,9 @@ def render_particles(
     extent = float(np.ptp(positions, axis=0).max()) if box is None else float(np.max(np.subtract(box[1], box[0])))
     d = np.asarray(direction, float)
     plotter.camera_position = [tuple(centre + d / np.linalg.norm(d) * 2.2 * extent), tuple(centre), up]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    plotter.screenshot(str(path))
+    image = plotter.screenshot(return_img=True)
     plotter.close()
-    return path
+    return np.asarray(image)[..., :3]
 
 
 def render_bed(bed, path: str | Path, **kwargs) -> Path:
@@ -118,3 +159,78 @@ def render_testbed(result, path: str | Path, **kwargs) -> Path:
     return render_particles(p["position"], p["radius"], path, scalars=speed, scalar_name="speed [m/s]",
                             box=(lo, hi), surface=(result.final_wheel_nodes, result.mesh.triangles),
                             **kwargs)
+
+
+PARTICLE_COLORS = {"speed": "speed [m/s]", "height": "height [m]"}
+
+
+def _frame_view(frame: dict, color: str, wheel_color: str | None):
+    if color not in PARTICLE_COLORS:
+        raise ValueError(f"color = {color!r}; choose one of {sorted(PARTICLE_COLORS)}")
+    if wheel_color not in (None, "deflection"):
+        raise ValueError(f"wheel_color = {wheel_color!r}; choose 'deflection' or None")
+    p = frame["position"]
+    scalars = np.linalg.norm(frame["velocity"], axis=1) if color == "speed" else p[:, 2]
+    wheel = 1e3 * np.linalg.norm(frame["deflection"], axis=1) if wheel_color else None
+    return scalars, wheel
+
+
+def result_box(result) -> tuple[np.ndarray, np.ndarray]:
+    """A fixed view box for every frame of a result: the bed's extent and the wheel's top."""
+    first, last = result.frame(0), result.frame(-1)
+    r = float(first["radius"].max())
+    lo = first["position"].min(axis=0) - r
+    hi = first["position"].max(axis=0) + r
+    hi[2] = max(hi[2], float(first["wheel_nodes"][:, 2].max()), float(last["wheel_nodes"][:, 2].max()))
+    return lo, hi
+
+
+def render_result_frame(result, path: str | Path, *, frame: int = -1, color: str = "speed",
+                        wheel_color: str | None = "deflection", **kwargs) -> Path:
+    """Render frame ``frame`` of a :class:`~wheelsoil.cases.results.Result` to a PNG: particles coloured by
+    speed (or height), the wheel by the magnitude of its deflection (displacement less the hub's rigid motion)."""
+    f = result.frame(frame)
+    scalars, wheel = _frame_view(f, color, wheel_color)
+    kwargs.setdefault("title", f"{result.attrs.get('case_name', '')}: t = {f['t']:.3f} s")
+    kwargs.setdefault("box", result_box(result))
+    return render_particles(f["position"], f["radius"], path, scalars=scalars, scalar_name=PARTICLE_COLORS[color],
+                            surface=(f["wheel_nodes"], f["triangles"]), surface_scalars=wheel, **kwargs)
+
+
+def render_animation(result, path: str | Path, *, fps: float = 10.0, color: str = "speed",
+                     wheel_color: str | None = "deflection", camera: str = "iso", size: tuple[int, int] = (960, 640),
+                     progress=None) -> Path:
+    """Every frame of a result as an animation: ``.gif`` or ``.mp4`` (H.264 through imageio-ffmpeg's own
+    ffmpeg: no system package needed). Colour ranges are fixed over the run; ``progress(k, n)`` is
+    called after each frame."""
+    import imageio.v2 as imageio
+
+    from wheelsoil.provenance import atomic_output
+
+    path = Path(path)
+    if path.suffix.lower() not in (".gif", ".mp4"):
+        raise ValueError(f"animation {path.name!r}: the file must end in .gif or .mp4")
+    n = len(result.frame_times)
+    box = result_box(result)
+    frames = [result.frame(k) for k in range(n)]
+    views = [_frame_view(f, color, wheel_color) for f in frames]
+    top = max(float(np.percentile(v[0], 99.5)) for v in views)
+    clim = (0.0, max(top, 1e-9)) if color == "speed" else (float(box[0][2]), float(box[1][2]))
+    surface_clim = (0.0, max(max(float(v[1].max()) for v in views), 1e-9)) if wheel_color else None
+    # even pixel sizes: H.264 needs them
+    size = (size[0] // 2 * 2, size[1] // 2 * 2)
+    with atomic_output(path) as tmp:
+        options = {"fps": fps} if path.suffix.lower() == ".mp4" else {"duration": 1.0 / fps, "loop": 0}
+        fmt = "FFMPEG" if path.suffix.lower() == ".mp4" else "GIF"
+        target = tmp.with_name(tmp.name + path.suffix.lower())  # the writers pick the format from the suffix
+        with imageio.get_writer(target, format=fmt, mode="I", **options) as writer:
+            for k, (f, (scalars, wheel)) in enumerate(zip(frames, views)):
+                image = render_image(f["position"], f["radius"], scalars=scalars, scalar_name=PARTICLE_COLORS[color],
+                                     box=box, camera=camera, size=size, surface=(f["wheel_nodes"], f["triangles"]),
+                                     surface_scalars=wheel, clim=clim, surface_clim=surface_clim,
+                                     title=f"{result.attrs.get('case_name', '')}: t = {f['t']:.3f} s")
+                writer.append_data(image)
+                if progress is not None:
+                    progress(k + 1, n)
+        os.replace(target, tmp)
+    return path

@@ -50,7 +50,9 @@ def to_unit(value, unit: str):
     allowed = UNITS[unit]
     match = _QUANTITY.match(value)
     if match is None:
-        raise UnitError(f"{value!r} is not a number with a unit (e.g. '1.5 {unit}'; units: {', '.join(allowed)})")
+        if unit == "1":
+            raise UnitError(f"{value!r} is not a number (or a percentage such as '30 %')")
+        raise UnitError(f"{value!r} is not a number, or a number with a unit ({', '.join(allowed)})")
     number, written = float(match.group(1)), (match.group(2) or unit)
     written = written.replace("²", "^2").replace("³", "^3").replace("·", " ")
     if written not in allowed:

@@ -1,0 +1,175 @@
+"""One run from a case file: result layout, round trip case -> result -> case, atomic write under a kill,
+resume equal to an uninterrupted run, the XDMF sidecar, renders of frames and animations."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from wheelsoil.cases.cli import EXIT_INPUT, main
+from wheelsoil.cases.results import load_result, partial_path
+from wheelsoil.cases.run import CHECKPOINT_NAME, RESULT_NAME, run_case
+from wheelsoil.cases.schema import load_case
+from wheelsoil.coupling.testbed import SERIES_UNITS, STEADY_QUANTITIES
+from wheelsoil.errors import WheelsoilInputError
+
+#: The mini case, short: about 0.32 s simulated (lowering, settling, 0.15 s of driving), frames every
+#: 0.05 s and checkpoints every 0.1 s.
+MINI = ["test.drive_time=0.15", "output.frame_interval=0.05", "output.checkpoint_interval=0.1",
+        "output.render=false"]
+
+
+@pytest.fixture(scope="module")
+def bed_cache(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bed-cache")
+    old = os.environ.get("WHEELSOIL_CACHE")
+    os.environ["WHEELSOIL_CACHE"] = str(path)  # the subprocess runs share it
+    yield path
+    if old is None:
+        os.environ.pop("WHEELSOIL_CACHE")
+    else:
+        os.environ["WHEELSOIL_CACHE"] = old
+
+
+@pytest.fixture(scope="module")
+def reference(bed_cache, tmp_path_factory):
+    """The mini case run uninterrupted."""
+    case = load_case("mini-1g-steer", MINI)
+    out = tmp_path_factory.mktemp("reference")
+    outcome = run_case(case, out)
+    return case, out, outcome
+
+
+def test_result_file_follows_the_architecture_layout(reference):
+    case, out, outcome = reference
+    assert sorted(p.name for p in out.iterdir()) == ["case.toml", "result.h5", "result.xdmf", "series.csv",
+                                                     "series.png", "summary.json"]
+    with h5py.File(out / RESULT_NAME, "r") as f:
+        for key in ("case_toml", "version", "git_rev", "taichi_version", "arch", "seed", "created"):
+            assert key in f.attrs, key
+        assert f.attrs["complete"] and f.attrs["arch"] == "cpu"
+        for name, unit in SERIES_UNITS.items():
+            assert f["series"][name].attrs["units"] == unit
+            assert f["series"][name].shape == f["series"]["t"].shape
+        for q in STEADY_QUANTITIES:
+            assert f"{q}_mean" in f["summary"].attrs and f"{q}_std" in f["summary"].attrs
+        assert f["summary"].attrs["window_end"] > f["summary"].attrs["window_start"]
+        assert f["mesh/nodes0"].shape[1] == 3 and f["mesh/triangles"].shape[1] == 3
+        frames = sorted(f["frames"])
+        t = np.array([f["frames"][k].attrs["t"] for k in frames])
+        radius = [f["frames"][k]["particles/radius"] for k in frames]
+        assert all(r.id == radius[0].id for r in radius)  # one copy, hard-linked
+        n = f["frames"][frames[0]]["particles/position"].shape[0]
+        assert all(f["frames"][k]["particles/velocity"].shape == (n, 3) for k in frames)
+        assert f["frames"][frames[-1]]["wheel/nodes"].shape == f["mesh/nodes0"].shape
+    # a frame at the first sample past each multiple of 0.05 s, and the last state
+    dt = case.output.sample_interval
+    expected = [k * 0.05 for k in range(1, int(t[-1] / 0.05) + 1)]
+    assert np.all(np.diff(t) > 0)
+    assert np.allclose(t[:-1], expected[: len(t) - 1], atol=1.01 * dt)
+    assert t[-1] == pytest.approx(outcome.testbed_result.series["t"][-1])
+
+
+def test_round_trip_case_to_result_to_case(reference, tmp_path):
+    case, out, outcome = reference
+    result = load_result(out)
+    assert result.case == case
+    assert result.attrs["case_hash"] == case.case_hash()
+    assert load_case(out / "case.toml") == case  # the run folder's case.toml runs the same case
+    for name in SERIES_UNITS:
+        np.testing.assert_array_equal(result.series[name], outcome.testbed_result.series[name])
+    assert result.steady("drawbar_pull") == outcome.testbed_result.summary["drawbar_pull"]["mean"]
+    frame = result.to_dataframe()
+    assert "drawbar_pull [N]" in frame.columns and frame.index.name == "t [s]"
+    assert len(frame) == len(result.series["t"])
+    row = result.summary_row()
+    assert row["case"] == "mini-1g-steer" and row["vertical_force_mean"] == result.steady("vertical_force")
+
+
+def test_xdmf_sidecar_opens_in_vtks_xdmf_reader(reference):
+    vtk = pytest.importorskip("vtk")
+    _, out, _ = reference
+    result = load_result(out)
+    reader = vtk.vtkXdmfReader()
+    reader.SetFileName(str(out / "result.xdmf"))
+    reader.UpdateInformation()
+    times = reader.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+    np.testing.assert_allclose(times, result.frame_times)
+    reader.Update()
+    blocks = reader.GetOutputDataObject(0)
+    last = result.frame(-1)
+    names = [blocks.GetMetaData(i).Get(vtk.vtkCompositeDataSet.NAME()) for i in range(blocks.GetNumberOfBlocks())]
+    particles, wheel = (blocks.GetBlock(names.index(n)) for n in ("particles", "wheel"))
+    assert particles.GetNumberOfPoints() == len(last["position"])
+    assert particles.GetPointData().GetArray("velocity").GetNumberOfComponents() == 3
+    assert wheel.GetNumberOfCells() == len(last["triangles"])
+    assert wheel.GetPointData().GetArray("deflection") is not None
+
+
+def test_a_killed_run_leaves_no_finished_file_and_resume_equals_the_uninterrupted_run(reference, tmp_path):
+    case, ref_out, _ = reference
+    out = tmp_path / "killed"
+    cmd = [sys.executable, "-m", "wheelsoil.cases.cli", "run", "mini-1g-steer", "--out", str(out)]
+    for item in MINI:
+        cmd += ["--set", item]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while not (out / CHECKPOINT_NAME).exists():
+        assert proc.poll() is None, "the run ended before its first checkpoint"
+        assert time.monotonic() < deadline, "no checkpoint within 300 s"
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    # nothing that looks finished: no result file, and the partial one says it is incomplete
+    assert not (out / RESULT_NAME).exists()
+    with h5py.File(partial_path(out / RESULT_NAME), "r") as f:
+        assert not f.attrs["complete"]
+    with pytest.raises(WheelsoilInputError, match="a partial file exists: the run did not finish"):
+        load_result(out)
+    # another case cannot resume it
+    with pytest.raises(WheelsoilInputError, match="the checkpoint in .* is of another case"):
+        run_case(load_case("mini-1g-steer", MINI + ["test.slip=0.4"]), out, resume=True)
+    outcome = run_case(case, out, resume=True)
+    assert outcome.resumed_from is not None and outcome.resumed_from > 0.09
+    a, b = load_result(ref_out), load_result(out)
+    for name in SERIES_UNITS:
+        np.testing.assert_array_equal(b.series[name], a.series[name], err_msg=name)
+    np.testing.assert_array_equal(b.frame_times, a.frame_times)
+    for k in range(len(a.frame_times)):
+        np.testing.assert_array_equal(b.frame(k)["position"], a.frame(k)["position"])
+        np.testing.assert_array_equal(b.frame(k)["wheel_nodes"], a.frame(k)["wheel_nodes"])
+    assert not (out / CHECKPOINT_NAME).exists() and not partial_path(out / RESULT_NAME).exists()
+
+
+def test_resume_without_a_checkpoint_is_refused(tmp_path, capsys):
+    rc = main(["run", "mini-1g-steer", "--resume", "--out", str(tmp_path / "empty")])
+    assert rc == EXIT_INPUT
+    assert "nothing to resume" in capsys.readouterr().err
+
+
+def _non_blank(image: np.ndarray) -> bool:
+    colours = np.unique(image.reshape(-1, image.shape[-1])[::97], axis=0)
+    return image.std() > 10 and len(colours) > 50
+
+
+def test_render_of_a_frame_and_an_animation(reference, tmp_path):
+    import imageio.v2 as imageio
+
+    _, out, _ = reference
+    result = load_result(out)
+    png = tmp_path / "frame.png"
+    assert main(["render", str(out), "--frame", "1", "--size", "640", "480", "--out", str(png)]) == 0
+    image = imageio.imread(png)
+    assert image.shape[:2] == (480, 640) and _non_blank(image[..., :3])
+    gif = tmp_path / "run.gif"
+    assert main(["render", str(out / RESULT_NAME), "--animate", "--size", "320", "240", "--out", str(gif)]) == 0
+    frames = imageio.mimread(gif)
+    assert len(frames) == len(result.frame_times)
+    assert all(f.shape[:2] == (240, 320) for f in frames)
+    assert not np.array_equal(frames[0], frames[-1])  # the wheel moved
+    assert main(["render", str(out), "--animate", "--out", str(tmp_path / "run.avi")]) == EXIT_INPUT

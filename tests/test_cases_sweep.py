@@ -1,0 +1,111 @@
+"""Batch sweeps: grid and rows, a small sweep with one deliberately failing case, skip and retry on a
+second run, the summary table and figures, and a sweep on a dask.distributed cluster."""
+
+import json
+import os
+
+import pandas as pd
+import pytest
+
+from wheelsoil.cases.cli import EXIT_OK, EXIT_SWEEP_FAILED, main
+from wheelsoil.cases.results import load_result
+from wheelsoil.cases.schema import CaseError
+from wheelsoil.cases.sweep import load_sweep, run_sweep
+
+COMMON = 'set = { "output.render" = false, "output.frame_interval" = 0.0, "output.checkpoint_interval" = 0.0, ' \
+         '"test.drive_time" = 0.1 }'
+
+
+@pytest.fixture(scope="module")
+def bed_cache(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bed-cache")
+    old = os.environ.get("WHEELSOIL_CACHE")
+    os.environ["WHEELSOIL_CACHE"] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop("WHEELSOIL_CACHE")
+    else:
+        os.environ["WHEELSOIL_CACHE"] = old
+
+
+def write(tmp_path, text, name="sweep.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_grid_times_rows_names_and_folders(tmp_path):
+    sweep = load_sweep("seed004-figures", tmp_path / "s")
+    assert len(sweep.cases) == 2 * 6 * 5
+    assert sweep.swept_keys == ["test.slip", "test.slip_angle", "soil.gravity", "test.load"]
+    moon = [c for c in sweep.cases if c.values["soil.gravity"] == "moon"]
+    assert len(moon) == 30 and all(c.case.test.load == 500.0 for c in moon)
+    assert all(c.case.output.render is False for c in sweep.cases)
+    assert len({c.folder for c in sweep.cases}) == 60  # one folder per case hash
+    assert sweep.cases[0].folder.parent == tmp_path / "s" / "cases"
+    assert sweep.cases[0].name == "seed004-figures-gravityearth-load3000-slip0.1-slip_angle0"
+
+
+def test_bad_sweep_files_name_the_problem(tmp_path):
+    with pytest.raises(CaseError, match="unknown key test.slp; did you mean test.slip"):
+        load_sweep(write(tmp_path, '[sweep]\nbase = "mini-1g-steer"\n[sweep.grid]\n"test.slp" = [0.1]\n'))
+    with pytest.raises(CaseError, match=r"case 1 \(test.slip=1.2\)"):
+        load_sweep(write(tmp_path, '[sweep]\nbase = "mini-1g-steer"\n[sweep.grid]\n"test.slip" = [0.1, 1.2]\n'))
+    with pytest.raises(CaseError, match="cases 0 and 1 are the same case"):
+        load_sweep(write(tmp_path, '[sweep]\nbase = "mini-1g-steer"\n[[sweep.rows]]\n"test.slip" = 0.2\n'
+                                   '[[sweep.rows]]\n"test.slip" = 0.2\n'))
+    with pytest.raises(CaseError, match="sweep.basis"):
+        load_sweep(write(tmp_path, '[sweep]\nbasis = "mini-1g-steer"\n'))
+    with pytest.raises(CaseError, match="no case file or preset"):
+        load_sweep(write(tmp_path, '[sweep]\nbase = "no-such-case"\n'))
+
+
+def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retries(bed_cache, tmp_path, capsys):
+    # the middle row cannot run: 5 s of driving leaves the 0.6 m bin (found when the run sets up)
+    path = write(tmp_path, f'[sweep]\nname = "three"\nbase = "mini-1g-steer"\n{COMMON}\n'
+                           '[[sweep.rows]]\n"test.slip" = 0.2\n'
+                           '[[sweep.rows]]\n"test.slip" = 0.4\n"test.drive_time" = 5.0\n'
+                           '[[sweep.rows]]\n"test.slip" = 0.5\n')
+    out = tmp_path / "out"
+    assert main(["batch", str(path), "--out", str(out), "--workers", "2"]) == EXIT_SWEEP_FAILED
+    text = capsys.readouterr().out
+    assert "2 run, 0 skipped (finished before), 1 failed" in text
+    status = json.loads((out / "status.json").read_text())
+    failed = [v for v in status.values() if v["status"] == "failed"]
+    assert len(failed) == 1 and "the bin (length 0.6 m) is too short" in failed[0]["error"]
+    assert failed[0]["values"] == {"test.slip": 0.4, "test.drive_time": 5.0}
+    csv = pd.read_csv(out / "summary.csv")
+    parquet = pd.read_parquet(out / "summary.parquet")
+    assert sorted(csv["test.slip"]) == [0.2, 0.5] and len(parquet) == 2
+    pd.testing.assert_frame_equal(csv, parquet, check_dtype=False)
+    for case in csv.itertuples():
+        result = load_result(out / "cases" / case.case_hash)
+        assert result.steady("drawbar_pull") == pytest.approx(case.drawbar_pull_mean, rel=1e-12)
+    for name in ("sinkage", "drawbar_pull", "lateral_force"):
+        assert (out / f"figure_{name}.png").stat().st_size > 10_000
+    # again: the finished cases are skipped (their results untouched), the failed one is retried
+    sweep = load_sweep(path, out)
+    stamps = {c.folder: (c.folder / "result.h5").stat().st_mtime_ns for c in sweep.cases if c.finished}
+    status = run_sweep(sweep, workers=2)
+    assert sorted(v["status"] for v in status.values()) == ["failed", "skipped (finished before)",
+                                                            "skipped (finished before)"]
+    assert all((folder / "result.h5").stat().st_mtime_ns == t for folder, t in stamps.items())
+
+
+def test_a_sweep_runs_on_a_dask_cluster(bed_cache, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    path = write(tmp_path, f'[sweep]\nbase = "mini-1g-steer"\n{COMMON}\n[sweep.grid]\n"test.slip" = [0.3]\n')
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        assert main(["batch", str(path), "--out", str(out), "--scheduler", cluster.scheduler_address]) == EXIT_OK
+    (case,) = load_sweep(path, out).cases
+    assert case.finished
+    assert load_result(case.folder).case == case.case
+    assert len(pd.read_parquet(out / "summary.parquet")) == 1
+
+
+def test_an_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    path = write(tmp_path, f'[sweep]\nbase = "mini-1g-steer"\n{COMMON}\n')
+    assert main(["batch", str(path), "--out", str(tmp_path / "x"), "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    assert "cannot reach the dask scheduler" in capsys.readouterr().err
