@@ -28,10 +28,16 @@ three minutes on two cores, bed preparation included):
 
     wheelsoil run
 
-the same wheel at Moon gravity with W = 500 N (equal wheel mass), or other rig settings:
+a case is a TOML file or a preset; see them, copy one with every key documented, change it:
 
-    wheelsoil run smoke-moon-steer
-    wheelsoil run smoke-1g-steer --slip 0.5 --slip-angle 20 --rigid --out runs/rigid
+    wheelsoil case list
+    wheelsoil case show smoke-moon-steer > my-case.toml
+    wheelsoil run my-case.toml --set test.slip=0.5 --set test.slip_angle=20 --out runs/my-case
+    wheelsoil render runs/my-case --animate --out runs/my-case/run.mp4
+
+sweep slip and steering angle (local processes, or --scheduler for a dask cluster):
+
+    wheelsoil batch mini-slip
 
 hold the semi-empirical model against measured data and name what it misses:
 
@@ -297,6 +303,9 @@ def cmd_batch(args) -> int:
 
 
 def cmd_case(args) -> int:
+    import os
+
+    os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "0")  # stdout is the case text: no Taichi banner
     from .schema import case_to_toml, load_case, preset_names, preset_text
 
     if args.action == "list":
@@ -528,7 +537,7 @@ def main(argv=None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_INPUT
-    from wheelsoil.granular import SimulationUnstableError, WheelsoilInputError
+    from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 
     try:
         return args.func(args)

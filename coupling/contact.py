@@ -281,11 +281,11 @@ class WheelContact(Interaction):
 
     def state(self) -> dict:
         """Per-particle contact history, the force accumulators and counters (for checkpoints)."""
-        out = {k: getattr(self, k) for k in self._STATE_SCALARS}
+        out = {key: getattr(self, key) for key in self._STATE_SCALARS}
         out["resultant"] = self._resultant.to_numpy()
         if self._arrays:
-            for k in ("hist_n", "hist_xi", "hist_count"):
-                out[k] = self._arrays[k].to_numpy()
+            for key in ("hist_n", "hist_xi", "hist_count"):
+                out[key] = self._arrays[key].to_numpy()
         return out
 
     def invalidate(self) -> None:
@@ -294,15 +294,15 @@ class WheelContact(Interaction):
 
     def restore_state(self, scene: Scene, state: dict) -> None:
         """Continue from a :meth:`state` taken with the same wheel on ``scene``'s particles."""
-        for k in self._STATE_SCALARS:
-            setattr(self, k, int(state[k]))
+        for key in self._STATE_SCALARS:
+            setattr(self, key, int(state[key]))
         self._resultant.from_numpy(np.asarray(state["resultant"], float))
         if "hist_count" in state:
             self._attach(scene)
-            for k in ("hist_n", "hist_xi", "hist_count"):
-                if tuple(np.shape(state[k])[:1]) != (scene.n_particles,):
-                    raise WheelsoilInputError(f"the saved contact history {k!r} is for another number of particles")
-                self._arrays[k].from_numpy(np.ascontiguousarray(state[k]))
+            for key in ("hist_n", "hist_xi", "hist_count"):
+                if tuple(np.shape(state[key])[:1]) != (scene.n_particles,):
+                    raise WheelsoilInputError(f"the saved contact history {key!r} is for another number of particles")
+                self._arrays[key].from_numpy(np.ascontiguousarray(state[key]))
         self._need_rebuild = True
 
     def nodal_forces(self) -> np.ndarray:

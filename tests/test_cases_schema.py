@@ -160,3 +160,14 @@ def test_cli_case_show_list_and_check(tmp_path, capsys):
     assert "valid" in capsys.readouterr().out
     assert main(["case", "check", str(write(tmp_path, "[test]\nslip = 3\n", "bad.toml"))]) == EXIT_INPUT
     assert "bad.toml: test.slip = 3" in capsys.readouterr().err
+
+
+def test_case_show_from_a_fresh_process_is_a_valid_case_file(tmp_path):
+    """stdout is only the case text (no Taichi banner), so `wheelsoil case show X > my.toml` works."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "wheelsoil.cases.cli", "case", "show", "smoke-moon-steer"],
+                          capture_output=True, text=True, check=True)
+    path = write(tmp_path, done.stdout, "copy.toml")
+    assert load_case(path, name="smoke-moon-steer") == load_case("smoke-moon-steer")
