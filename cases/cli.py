@@ -64,26 +64,42 @@ def _gravity(value: str) -> float:
     return g
 
 
-def _add_bed_options(p: argparse.ArgumentParser, *, length=0.5, width=0.25, depth=0.1) -> None:
-    g = p.add_argument_group("soil bed")
-    g.add_argument("--length", type=float, default=length, help=f"bin length along x [m] (default {length})")
-    g.add_argument("--width", type=float, default=width, help=f"bin width along y [m] (default {width})")
-    g.add_argument("--depth", type=float, default=depth, help=f"levelled bed depth [m] (default {depth})")
-    g.add_argument("--dmin", type=float, default=0.016, help="smallest particle diameter [m] (default 0.016, seed 004)")
-    g.add_argument("--dmax", type=float, default=0.024, help="largest particle diameter [m] (default 0.024, seed 004)")
-    g.add_argument("--gravity", type=_gravity, default=GRAVITY_PRESETS["earth"],
+BED_DEFAULTS = {"length": 0.5, "width": 0.25, "depth": 0.1, "dmin": 0.016, "dmax": 0.024,
+                "gravity": GRAVITY_PRESETS["earth"], "seed": 0}
+
+
+def _add_bed_options(p: argparse.ArgumentParser) -> None:
+    d = BED_DEFAULTS
+    g = p.add_argument_group("soil bed (without a CASE)")
+    g.add_argument("--length", type=float, default=None, help=f"bin length along x [m] (default {d['length']})")
+    g.add_argument("--width", type=float, default=None, help=f"bin width along y [m] (default {d['width']})")
+    g.add_argument("--depth", type=float, default=None, help=f"levelled bed depth [m] (default {d['depth']})")
+    g.add_argument("--dmin", type=float, default=None, help="smallest particle diameter [m] (default 0.016, seed 004)")
+    g.add_argument("--dmax", type=float, default=None, help="largest particle diameter [m] (default 0.024, seed 004)")
+    g.add_argument("--gravity", type=_gravity, default=None,
                    help="'earth' (9.81), 'moon' (9.81/6) or a value in m/s^2 (default earth); "
                         "beds are prepared under the gravity they are tested at")
-    g.add_argument("--seed", type=int, default=0, help="random seed of radii and packing (default 0)")
-    g.add_argument("--no-cache", action="store_true", help="prepare afresh even if an identical bed is cached")
+    g.add_argument("--seed", type=int, default=None, help="random seed of radii and packing (default 0)")
+    p.add_argument("--no-cache", action="store_true", help="prepare afresh even if an identical bed is cached")
     p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
 
 
 def _spec_from_args(args):
     from wheelsoil.granular import BedSpec
 
-    return BedSpec(length=args.length, width=args.width, depth=args.depth, diameter_min=args.dmin,
-                   diameter_max=args.dmax, gravity=(0.0, 0.0, -args.gravity), seed=args.seed)
+    given = [k for k in BED_DEFAULTS if getattr(args, k) is not None]
+    if getattr(args, "case", None):
+        if given:
+            raise _InputError(f"--{given[0]} does not go with a CASE: set the case's soil instead, e.g. "
+                              f"--set soil.length=1.0 ('wheelsoil case show {args.case}' lists the keys)")
+        from .schema import load_case
+
+        return load_case(args.case, args.set or []).bed_spec()
+    if args.set:
+        raise _InputError("--set needs a CASE (e.g. wheelsoil prepare-bed smoke-1g-steer --set soil.gravity=moon)")
+    v = {k: (getattr(args, k) if getattr(args, k) is not None else BED_DEFAULTS[k]) for k in BED_DEFAULTS}
+    return BedSpec(length=v["length"], width=v["width"], depth=v["depth"], diameter_min=v["dmin"],
+                   diameter_max=v["dmax"], gravity=(0.0, 0.0, -v["gravity"]), seed=v["seed"])
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -152,11 +168,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
     p.set_defaults(func=cmd_batch)
 
-    p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin; write it to HDF5",
+    p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin (a case's, or from options); write it",
                        description="Fill a bin with polydisperse spheres, settle under gravity until the kinetic "
                                    "energy per particle is below the threshold, level at the target depth, and "
-                                   "write the bed to HDF5. Identical beds are reused from the cache "
+                                   "write the bed to HDF5. With a CASE (file or preset, plus --set overrides) the "
+                                   "bed is the case's soil, the one 'wheelsoil run CASE' uses; without, the "
+                                   "options below describe it. Identical beds are reused from the cache "
                                    "(WHEELSOIL_CACHE, default ~/.cache/wheelsoil).")
+    p.add_argument("case", nargs="?", default=None, help="case file (.toml) or preset whose bed to prepare")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override a case key (repeatable)")
     _add_bed_options(p)
     p.add_argument("--out", type=Path, default=Path("bed.h5"), help="bed file to write (default bed.h5)")
     p.set_defaults(func=cmd_prepare_bed)

@@ -171,3 +171,12 @@ def test_case_show_from_a_fresh_process_is_a_valid_case_file(tmp_path):
                           capture_output=True, text=True, check=True)
     path = write(tmp_path, done.stdout, "copy.toml")
     assert load_case(path, name="smoke-moon-steer") == load_case("smoke-moon-steer")
+
+
+def test_prepare_bed_takes_a_case_or_options_not_both(capsys):
+    assert main(["prepare-bed", "mini-1g-steer", "--length", "2"]) == EXIT_INPUT
+    assert "--length does not go with a CASE: set the case's soil instead" in capsys.readouterr().err
+    assert main(["prepare-bed", "--set", "soil.length=2"]) == EXIT_INPUT
+    assert "--set needs a CASE" in capsys.readouterr().err
+    assert main(["prepare-bed", "mini-1g-steer", "--set", "soil.lenght=2"]) == EXIT_INPUT
+    assert "unknown key soil.lenght; did you mean soil.length?" in capsys.readouterr().err
