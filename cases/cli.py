@@ -235,9 +235,11 @@ def build_parser() -> argparse.ArgumentParser:
                                    "held-out error and BIC, and write report.md, findings.json and plots to "
                                    "--report. DATA: a folder of CMU trial files, the digitised single-wheel CSV, a "
                                    "CSV in wheelsoil's format (slip, vertical_load_N, wheel_radius_m, "
-                                   "wheel_width_m, drawbar_pull_N, ...), or 'synthetic' (a hidden mechanism, "
-                                   "revealed at the end of the report).")
-    p.add_argument("data", help="measured data (folder or CSV), or 'synthetic'")
+                                   "wheel_width_m, drawbar_pull_N, ...), a wheelsoil sweep folder (the DEM-FEM "
+                                   "runs of 'wheelsoil batch' as data: what the classical model misses of the "
+                                   "simulation), or 'synthetic' (a hidden mechanism, revealed at the end of the "
+                                   "report).")
+    p.add_argument("data", help="measured data (folder or CSV), a sweep folder, or 'synthetic'")
     p.add_argument("--model", choices=["semi-empirical"], default="semi-empirical",
                    help="model to hold against the data (default semi-empirical)")
     p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")

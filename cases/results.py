@@ -69,8 +69,9 @@ class ResultWriter:
                 self.file.attrs[key] = value
             self.file.attrs["complete"] = False
             g = self.file.create_group("mesh")
-            for key in ("nodes0", "triangles", "beams"):
-                g.create_dataset(key, data=np.asarray(mesh[key]))
+            g.create_dataset("nodes0", data=np.asarray(mesh["nodes0"], np.float64))
+            for key in ("triangles", "beams"):  # int64: the XDMF sidecar declares 8-byte integers
+                g.create_dataset(key, data=np.asarray(mesh[key], np.int64).reshape(-1, 3 if key == "triangles" else 2))
             self.file.create_group("frames")
             self.n_frames = 0
         else:

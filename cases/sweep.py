@@ -273,7 +273,8 @@ def _write_status(sweep: Sweep, status: dict) -> None:
 
 # -------------------------------------------------------------------- summary
 def summary_table(sweep: Sweep):
-    """A pandas DataFrame: one row per finished case with its swept values, rig settings and steady means."""
+    """A pandas DataFrame: one row per finished case with its swept values, rig settings and wheel, and the
+    steady means and standard deviations (SI: N, m, N m; angles in degrees; gravity in m/s^2)."""
     import pandas as pd
 
     from .results import load_result
@@ -286,8 +287,11 @@ def summary_table(sweep: Sweep):
         t = c.case.test
         row = {"case": c.name, "case_hash": c.folder.name}
         row.update({k: (_label(v) if isinstance(v, (list, tuple)) else v) for k, v in c.values.items()})
+        wheel = c.case.wheel_geometry()
         row.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "load_set": t.load,
-                    "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid})
+                    "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
+                    "wheel_radius": wheel.radius, "wheel_width": wheel.width, "grouser_count": wheel.grouser_count,
+                    "grouser_height": wheel.grouser_height if wheel.grouser_count else 0.0})
         row.update({k: v for k, v in r.summary_row().items() if k not in ("case", "case_hash")})
         rows.append(row)
     return pd.DataFrame(rows)

@@ -23,6 +23,9 @@ EXAMPLES = {
     "digitised-ding2011": (str(MEASURED / "digitised_single_wheel" / "single_wheel_experiments.csv"),
                            ["--group", "ding2011"], "Ding et al. 2011, smooth and lugged wheel, DP/sinkage/torque"),
     "synthetic-hidden": ("synthetic", ["--seed", "5"], "a mechanism hidden in synthetic data, drawn at random"),
+    "dem-smoke-figures": ("docs/sweeps/smoke-figures/summary.csv", [],
+                          "the 18 DEM-FEM runs of the smoke-figures sweep as data: what does the classical model "
+                          "miss of the simulation?"),
 }
 
 

@@ -83,6 +83,15 @@ def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retrie
         assert result.steady("drawbar_pull") == pytest.approx(case.drawbar_pull_mean, rel=1e-12)
     for name in ("sinkage", "drawbar_pull", "lateral_force"):
         assert (out / f"figure_{name}.png").stat().st_size > 10_000
+    # the validation workflow reads the finished cases as a dataset (wheelsoil validate SWEEP_FOLDER)
+    from wheelsoil.validation.measured import load_measurements
+
+    data = load_measurements(out)
+    order = sorted(range(len(data)), key=lambda k: data.slip[k])
+    assert list(data.slip[order]) == [0.2, 0.5] and set(data.group) == {"1g"}
+    assert list(data.responses["drawbar_pull"][order]) == list(csv.sort_values("test.slip")["drawbar_pull_mean"])
+    assert list(data.responses["sinkage"][order]) == list(csv.sort_values("test.slip")["tread_sinkage_mean"])
+    assert set(data.radius) == {0.15} and set(data.grouser_count) == {8.0}
     # again: the finished cases are skipped (their results untouched), the failed one is retried
     sweep = load_sweep(path, out)
     stamps = {c.folder: (c.folder / "result.h5").stat().st_mtime_ns for c in sweep.cases if c.finished}

@@ -67,3 +67,23 @@ def test_bad_files_name_the_problem(tmp_path):
     (tmp_path / "smooth_wheel_trials.csv").write_text("slip,drawbar_pull_N\n0.1,3\n")
     with pytest.raises(WheelsoilInputError, match=r"missing column\(s\) \['steering_angle'"):
         load_cmu_trials(tmp_path)
+
+
+def test_sweep_summary_reads_as_simulated_data_and_a_partial_table_is_refused(tmp_path):
+    import pandas as pd
+
+    from wheelsoil.validation.measured import SIMULATED_RESPONSES, load_measurements
+
+    row = {"slip_set": 0.3, "slip_angle_set": 10.0, "load_set": 500.0, "gravity": 9.81 / 6, "wheel_radius": 0.6,
+           "wheel_width": 0.5, "grouser_count": 24, "grouser_height": 0.02}
+    for k, src in enumerate(SIMULATED_RESPONSES.values()):
+        row[f"{src}_mean"], row[f"{src}_std"] = 10.0 * (k + 1), 1.0 * (k + 1)
+    path = tmp_path / "summary.csv"
+    pd.DataFrame([row, {**row, "gravity": 9.81, "load_set": 3000.0}]).to_csv(path, index=False)
+    data = load_measurements(tmp_path)  # the sweep folder
+    assert list(data.group) == ["moon", "1g"] and list(data.load) == [500.0, 3000.0]
+    assert data.responses["sinkage"][0] == row["tread_sinkage_mean"]  # the rut depth, without deflection
+    assert data.std["torque"][1] == row["torque_std"]
+    pd.DataFrame([{k: v for k, v in row.items() if k != "wheel_radius"}]).to_csv(path, index=False)
+    with pytest.raises(WheelsoilInputError, match=r"not a wheelsoil sweep summary: columns \['wheel_radius'\]"):
+        load_measurements(path)

@@ -247,14 +247,61 @@ def load_generic(path: str | Path, name: str | None = None) -> Measurements:
     )
 
 
+def load_sweep_summary(path: str | Path) -> Measurements:
+    """The DEM--FEM runs of a wheelsoil sweep as a dataset, from its ``summary.csv`` (or the sweep folder):
+    the rig settings and wheel of each case and its steady-state means and standard deviations.
+
+    Sinkage is the tread sinkage (the rut depth below the levelled surface, without the wheel's
+    deflection), the quantity the rigid-wheel model predicts; the lateral force keeps wheelsoil's sign
+    (it opposes the lateral slip). Groups are the gravity levels ("1g", "moon" or the value).
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if path.is_dir():
+        path = path / "summary.csv"
+    if not path.is_file():
+        raise WheelsoilInputError(f"{path} does not exist: a sweep folder has summary.csv once 'wheelsoil batch' "
+                                  "has finished cases")
+    t = pd.read_csv(path)
+    needed = ["slip_set", "slip_angle_set", "load_set", "gravity", "wheel_radius", "wheel_width", "grouser_count",
+              "grouser_height"] + [f"{src}_{k}" for src in SIMULATED_RESPONSES.values() for k in ("mean", "std")]
+    missing = [c for c in needed if c not in t.columns]
+    if missing:
+        raise WheelsoilInputError(f"{path} is not a wheelsoil sweep summary: columns {missing} are missing")
+    g = t["gravity"].to_numpy(float)
+    group = np.where(np.abs(g - 9.81) < 0.05, "1g", np.where(np.abs(g - 9.81 / 6) < 0.05, "moon",
+                                                             np.char.add("g", np.round(g, 3).astype(str))))
+    col = lambda key: t[key].to_numpy(float)  # noqa: E731
+    return Measurements(
+        name=path.parent.name, slip=col("slip_set"), slip_angle=col("slip_angle_set"), load=col("load_set"),
+        gravity=g, radius=col("wheel_radius"), width=col("wheel_width"), grouser_height=col("grouser_height"),
+        grouser_count=col("grouser_count"), group=group.astype(str),
+        responses={q: col(f"{src}_mean") for q, src in SIMULATED_RESPONSES.items()},
+        std={q: col(f"{src}_std") for q, src in SIMULATED_RESPONSES.items()},
+        notes=f"{len(t)} DEM-FEM runs of the wheelsoil sweep summarised in {path}; sinkage is the tread sinkage",
+    )
+
+
+#: Dataset response -> the steady quantity of a wheelsoil result it is read from.
+SIMULATED_RESPONSES = {"drawbar_pull": "drawbar_pull", "lateral_force": "lateral_force",
+                       "sinkage": "tread_sinkage", "torque": "torque"}
+
+
 def load_measurements(path: str | Path) -> Measurements:
-    """Any supported dataset: a folder of CMU trial files, the digitised-points CSV, or wheelsoil's format."""
+    """Any supported dataset: a folder of CMU trial files, a wheelsoil sweep folder or its summary.csv
+    (simulated), the digitised-points CSV, or wheelsoil's CSV format."""
     path = Path(path)
     if path.is_dir():
         if (path / "grouser_wheel_trials.csv").is_file():
             return load_cmu_trials(path)
-        raise WheelsoilInputError(f"{path} is a folder without grouser_wheel_trials.csv / smooth_wheel_trials.csv")
+        if (path / "summary.csv").is_file():
+            return load_sweep_summary(path)
+        raise WheelsoilInputError(f"{path} is neither a folder of CMU trials (grouser_wheel_trials.csv / "
+                                  "smooth_wheel_trials.csv) nor a wheelsoil sweep folder (summary.csv)")
     header = load_table(path).columns
+    if "tread_sinkage_mean" in header:
+        return load_sweep_summary(path)
     if "meas_drawbar_pull" in header:
         return load_digitised(path)
     return load_generic(path)
