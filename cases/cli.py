@@ -135,6 +135,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-render", action="store_true", help="shortcut for --set output.render=false")
     p.add_argument("--resume", action="store_true", help="continue a killed run of the same case from its last "
                                                          "checkpoint in --out")
+    p.add_argument("--restart", action="store_true", help="discard the checkpoint of an unfinished run in --out "
+                                                          "and start afresh")
     p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/<case name>)")
     p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
     p.set_defaults(func=cmd_run)
@@ -284,7 +286,8 @@ def cmd_run(args) -> int:
     console = _console()
     case = _load_case_from_args(args)
     out = args.out or Path("wheelsoil-output") / case.name
-    outcome = run_case(case, out, arch=args.arch, resume=args.resume, progress=console.is_terminal, console=console)
+    outcome = run_case(case, out, arch=args.arch, resume=args.resume, restart=args.restart,
+                       progress=console.is_terminal, console=console)
     s = outcome.testbed_result.summary
     console.print(("steady state" if s["steady"] else "[yellow]no steady state detected; averaged the last half[/]")
                   + f" over t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s:")

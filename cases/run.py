@@ -83,10 +83,13 @@ def load_checkpoint(path: Path) -> tuple[dict, dict]:
 
 # -------------------------------------------------------------------- the run
 def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume: bool = False,
-             progress: bool = False, console=None, bed_cache: str | Path | None = None) -> RunOutcome:
+             restart: bool = False, progress: bool = False, console=None,
+             bed_cache: str | Path | None = None) -> RunOutcome:
     """Run ``case`` and write its folder ``out`` (see the module docstring).
 
     ``resume``: continue from ``out``'s checkpoint (an error names what is missing or different).
+    ``restart``: discard the checkpoint of an unfinished run in ``out`` and start afresh; without it
+    (or ``resume``) such a folder is refused, so that no progress is thrown away by accident.
     ``bed_cache``: the bed cache folder (default ``WHEELSOIL_CACHE`` or ``~/.cache/wheelsoil``).
     Raises :class:`~wheelsoil.errors.WheelsoilInputError` for bad input and
     :class:`~wheelsoil.errors.SimulationUnstableError` when the run blows up; a run that fails after
@@ -101,9 +104,12 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     ckpt_path = out / CHECKPOINT_NAME
     case_hash = case.case_hash()
     ckpt_state = None
+    if resume and restart:
+        raise WheelsoilInputError("--resume and --restart exclude each other")
     if resume:
         if not ckpt_path.is_file():
-            raise WheelsoilInputError(f"nothing to resume in {out}: no checkpoint ({CHECKPOINT_NAME}); "
+            done = " (the run there finished)" if result_path.is_file() else ""
+            raise WheelsoilInputError(f"nothing to resume in {out}: no checkpoint ({CHECKPOINT_NAME}){done}; "
                                       "run without --resume")
         ckpt_state, meta = load_checkpoint(ckpt_path)
         if meta.get("case_hash") != case_hash:
@@ -111,6 +117,11 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
                 f"the checkpoint in {out} is of another case (hash {meta.get('case_hash')}, this case {case_hash}); "
                 "resume with the same case file and --set overrides, or run without --resume")
     else:
+        if ckpt_path.is_file() and not restart:
+            _, meta = load_checkpoint(ckpt_path)
+            raise WheelsoilInputError(
+                f"{out} holds an unfinished run with a checkpoint at t = {meta.get('t', 0.0):.3f} s: --resume "
+                "continues it, --restart discards it")
         ckpt_path.unlink(missing_ok=True)
         partial_path(result_path).unlink(missing_ok=True)
 

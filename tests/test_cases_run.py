@@ -131,6 +131,9 @@ def test_a_killed_run_leaves_no_finished_file_and_resume_equals_the_uninterrupte
         assert not f.attrs["complete"]
     with pytest.raises(WheelsoilInputError, match="a partial file exists: the run did not finish"):
         load_result(out)
+    # a plain rerun would throw the progress away: it is refused and says how to go on
+    with pytest.raises(WheelsoilInputError, match="holds an unfinished run with a checkpoint at t = 0.1.* --resume"):
+        run_case(case, out)
     # another case cannot resume it
     with pytest.raises(WheelsoilInputError, match="the checkpoint in .* is of another case"):
         run_case(load_case("mini-1g-steer", MINI + ["test.slip=0.4"]), out, resume=True)
