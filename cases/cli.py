@@ -153,12 +153,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("batch", help="run a sweep of cases (local processes or a dask cluster); summary and figures",
                        description="Run a sweep file: a base case plus lists to combine (grid) or explicit rows "
                                    "(cases/sweep.py documents the format; 'wheelsoil batch mini-slip' is a small "
-                                   "preset, seed004-figures the paper's 60 cases). Each case runs in its own process "
+                                   "preset, smoke-figures and smoke-flexible-rigid the smoke-scale trends, "
+                                   "seed004-figures the paper's 90 cases). Each case runs in its own process "
                                    "and writes <out>/cases/<case hash>/; finished cases are skipped when the sweep "
                                    "runs again, failed ones retried; one failing case never stops the others. Writes "
                                    "status.json, summary.csv, summary.parquet and figure_{sinkage,drawbar_pull,"
                                    "lateral_force}.png (seed 004 Figs. 6-8). Exit code 4 when some cases failed.")
-    p.add_argument("sweep", help="sweep file (.toml) or preset (mini-slip, smoke-figures, seed004-figures)")
+    p.add_argument("sweep", help="sweep file (.toml) or preset (mini-slip, smoke-figures, smoke-flexible-rigid, "
+                                 "seed004-figures)")
     p.add_argument("--out", type=Path, default=None, help="sweep folder (default wheelsoil-output/sweeps/<name>)")
     p.add_argument("--workers", type=int, default=None,
                    help="local worker processes (default: the CPU count; a coupled run keeps about one core busy)")

@@ -62,26 +62,30 @@ SWEEP_FIGURES = {
 
 
 def plot_sweep(table, out: str | Path, title: str) -> list[Path]:
-    """One figure per quantity against slip: a panel per steering angle, a line per gravity and load
-    (seed 004 Figs. 6--8), error bars one standard deviation of the steady window. Returns the paths."""
+    """One figure per quantity against slip: a panel per steering angle, a line per gravity, load and wheel
+    (flexible or rigid) (seed 004 Figs. 6--8), error bars one standard deviation of the steady window.
+    Returns the paths."""
     from wheelsoil.provenance import atomic_output
 
     plt = _pyplot()
     out = Path(out)
     angles = sorted(table["slip_angle_set"].unique())
-    groups = sorted({(g, w) for g, w in zip(table["gravity"], table["load_set"])}, key=lambda gw: (-gw[0], -gw[1]))
+    groups = sorted({(g, w, bool(r)) for g, w, r in zip(table["gravity"], table["load_set"], table["rigid"])},
+                    key=lambda gwr: (-gwr[0], -gwr[1], gwr[2]))
     written = []
     for fig_name, (column, label, scale) in SWEEP_FIGURES.items():
         fig, axes = plt.subplots(1, len(angles), figsize=(3.4 * len(angles) + 0.6, 3.4), sharey=True, squeeze=False)
         for ax, beta in zip(axes[0], angles):
-            for k, (g, w) in enumerate(groups):
-                sel = table[(table["slip_angle_set"] == beta) & (table["gravity"] == g) & (table["load_set"] == w)]
+            for k, (g, w, rigid) in enumerate(groups):
+                sel = table[(table["slip_angle_set"] == beta) & (table["gravity"] == g) & (table["load_set"] == w)
+                            & (table["rigid"].astype(bool) == rigid)]
                 sel = sel.sort_values("slip_set")
                 if sel.empty:
                     continue
                 gname = "1g" if abs(g - 9.81) < 0.05 else ("1/6 g" if abs(g - 9.81 / 6) < 0.05 else f"{g:.3g} m/s²")
                 ax.errorbar(sel["slip_set"], scale * sel[f"{column}_mean"], yerr=scale * sel[f"{column}_std"],
-                            marker="os^vD"[k % 5], capsize=2, label=f"{gname}, W = {w:g} N")
+                            marker="os^vD"[k % 5], capsize=2,
+                            label=f"{gname}, W = {w:g} N{', rigid wheel' if rigid else ''}")
             ax.set_title(f"β = {beta:g}°")
             ax.set_xlabel("slip i")
             ax.grid(alpha=0.3)

@@ -36,12 +36,13 @@ def write(tmp_path, text, name="sweep.toml"):
 
 def test_grid_times_rows_names_and_folders(tmp_path):
     sweep = load_sweep("seed004-figures", tmp_path / "s")
-    assert len(sweep.cases) == 2 * 6 * 5
+    assert len(sweep.cases) == 3 * 6 * 5  # 1g with 3000 N and 500 N, 1/6 g with 500 N; slip x steering angle
     assert sweep.swept_keys == ["test.slip", "test.slip_angle", "soil.gravity", "test.load"]
     moon = [c for c in sweep.cases if c.values["soil.gravity"] == "moon"]
     assert len(moon) == 30 and all(c.case.test.load == 500.0 for c in moon)
+    assert sorted({c.case.test.slip_angle for c in sweep.cases}) == [0, 5, 10, 15, 20]
     assert all(c.case.output.render is False for c in sweep.cases)
-    assert len({c.folder for c in sweep.cases}) == 60  # one folder per case hash
+    assert len({c.folder for c in sweep.cases}) == 90  # one folder per case hash
     assert sweep.cases[0].folder.parent == tmp_path / "s" / "cases"
     assert sweep.cases[0].name == "seed004-figures-gravityearth-load3000-slip0.1-slip_angle0"
 
