@@ -254,6 +254,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="responses to fit: drawbar_pull lateral_force sinkage torque (default: those measured)")
     p.add_argument("--hidden", default=None, help="synthetic only: mechanism to hide, or 'none' (default: random)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the hold-out split and synthetic data")
+    p.add_argument("--periodic", default=None, metavar="QUANTITY",
+                   help="sweep folders: instead of the steady-state model, find the dominant oscillation of QUANTITY "
+                        "(e.g. torque, drawbar_pull) in each run's series (tested against red noise) and the "
+                        "frequency law that explains them (grouser passing, spoke stiffness, once per turn, "
+                        "seed 002's slip-dependent wave); writes periodic.md and periodic.json to --report")
     p.add_argument("--group", default=None,
                    help="keep the rows whose group starts with this (e.g. ding2011: one rig and soil of the "
                         "digitised set; grouser or smooth in the CMU set)")
@@ -262,6 +267,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_validate(args) -> int:
+    if args.periodic:
+        from wheelsoil.validation.periodic import periodic_report
+
+        command = "wheelsoil " + " ".join(args.argv)
+        out = periodic_report(args.data, args.periodic, report=args.report, command=command)
+        console = _console()
+        for r in out["runs"]:
+            console.print(f"  {r['case']}: f = {r['frequency_hz']:.2f} Hz, p = {r['p_value']:.1e}, "
+                          f"{r['cycles']:.1f} cycles{'  significant' if r['significant'] else ''}")
+        console.print(f"frequency law: {out['found'] or 'none within tolerance'}; wrote {out['report']}")
+        return EXIT_OK
     from wheelsoil.validation.workflow import main_validate
 
     return main_validate(args)
