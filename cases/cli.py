@@ -276,7 +276,10 @@ def cmd_validate(args) -> int:
         for r in out["runs"]:
             console.print(f"  {r['case']}: f = {r['frequency_hz']:.2f} Hz, p = {r['p_value']:.1e}, "
                           f"{r['cycles']:.1f} cycles{'  significant' if r['significant'] else ''}")
-        console.print(f"frequency law: {out['found'] or 'none within tolerance'}; wrote {out['report']}")
+        for config, found in out["configurations"].items():
+            verdict = found["found"] or found.get("note") or "none within tolerance"
+            console.print(f"{config}: frequency law: {verdict} ({found['significant_runs']} significant runs)")
+        console.print(f"wrote {out['report']}")
         return EXIT_OK
     from wheelsoil.validation.workflow import main_validate
 

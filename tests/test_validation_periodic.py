@@ -68,6 +68,8 @@ def _runs(rng, law, params, *, grousers, spokes, amplitude):
                 f = spokes * omega / (2 * np.pi)
             elif law == "slip_density_wave":
                 f = params["a_hz"] + params["b_hz"] * slip
+            elif law == "natural_mode":
+                f = params["a_hz"]
             y = 100.0 * slip + 5.0 * T + rng.normal(0.0, 1.0, T.size)  # drawbar pull with noise of 1 N
             if law is not None:
                 y = y + amplitude * np.sin(2 * np.pi * f * T + rng.uniform(0, 2 * np.pi))
@@ -75,10 +77,10 @@ def _runs(rng, law, params, *, grousers, spokes, amplitude):
     return runs
 
 
-@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("seed", range(10))
 def test_hidden_frequency_law_is_named(seed):
     rng = np.random.default_rng(seed)
-    law = [None, "grouser_passing", "spoke_stiffness", "slip_density_wave"][seed % 4]
+    law = [None, "grouser_passing", "spoke_stiffness", "slip_density_wave", "natural_mode"][seed % 5]
     grousers, spokes = int(rng.integers(10, 21)), int(rng.integers(4, 9))
     params = {"a_hz": float(rng.uniform(4.0, 7.0)), "b_hz": float(rng.uniform(-5.0, -2.0))}
     amplitude = float(rng.uniform(0.5, 2.0))  # 0.5-2 N against 1 N of noise
@@ -136,3 +138,16 @@ def test_runs_from_results_take_the_drive_and_name_grouser_passing_in_red_noise(
     assert found["found"] == "grouser_passing", found
     with pytest.raises(WheelsoilInputError, match="has no series 'drawbar_pull'"):
         runs_from_results(results, "drawbar_pull")
+
+
+def test_a_constant_frequency_at_one_wheel_speed_is_not_named():
+    """At one wheel speed a natural mode and every counting law predict a constant: nothing may be named,
+    and the note says to vary the speed."""
+    rng = np.random.default_rng(6)
+    runs = []
+    for slip in (0.1, 0.3, 0.5, 0.7):
+        y = 100.0 * slip + rng.normal(0.0, 1.0, T.size) + 2.0 * np.sin(2 * np.pi * 4.4 * T + rng.uniform(0, 6))
+        runs.append(Run(1.0, slip, dominant_component(T, y)))
+    found = explain_frequencies(runs, grousers=24, spokes=12)
+    assert found["found"] is None
+    assert "vary the wheel speed" in found["note"] and "4.4" in found["note"]

@@ -9,12 +9,16 @@ wheel). Each of these is a frequency law for a run at wheel speed omega and slip
 * ``grouser_passing``: f = N_g omega / (2 pi) (N_g grousers per turn);
 * ``spoke_stiffness``: f = N_s omega / (2 pi) (N_s spokes or stiffness peaks per turn);
 * ``wheel_rotation``: f = omega / (2 pi) (run-out, once per turn);
-* ``slip_density_wave``: f = a + b i (seed 002 eqs. 20, 25; two parameters fitted across runs).
+* ``slip_density_wave``: f = a + b i (seed 002 eqs. 20, 25; two parameters fitted across runs);
+* ``natural_mode``: f = f0, whatever the wheel speed and slip: a mode of the rig that the rolling only
+  excites, such as the wheel's mass heaving on the stiffness of the soil and the wheel (one parameter;
+  named only when the runs span more than one wheel speed, since at one speed every counting law is a
+  constant too).
 
 :func:`dominant_component` finds the strongest sinusoid of one series (linear trend removed, periodogram
 peak refined by least squares) and tests it against white noise with Fisher's g statistic.
 :func:`explain_frequencies` compares the laws across runs by the spread of the measured frequencies
-about each law, with BIC charging the slip law for its two parameters: it must beat the best counting law
+about each law, with BIC charging the fitted laws for their parameters: each must beat the simpler laws
 by :data:`BIC_MARGIN`.
 """
 
@@ -178,6 +182,11 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
         rel = (f - pred) / f
         out["laws"][name] = {"rms_relative_error": float(np.sqrt(np.mean(rel ** 2))), "parameters": {},
                              "bic": n * np.log(max(np.mean(rel ** 2), 1e-300))}
+    rel = (f - f.mean()) / f
+    out["laws"]["natural_mode"] = {
+        "rms_relative_error": float(np.sqrt(np.mean(rel ** 2))), "parameters": {"f_hz": float(f.mean())},
+        "bic": n * np.log(max(np.mean(rel ** 2), 1e-300)) + np.log(n),
+    }
     if np.ptp(slip) > 0:
         coef = np.polyfit(slip, f, 1)
         rel = (f - np.polyval(coef, slip)) / f
@@ -186,14 +195,22 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
             "parameters": {"a_hz": float(coef[1]), "b_hz": float(coef[0])},
             "bic": n * np.log(max(np.mean(rel ** 2), 1e-300)) + 2 * np.log(n),
         }
-    counting = [k for k in out["laws"] if k != "slip_density_wave"]
+    counting = [k for k in out["laws"] if k not in ("slip_density_wave", "natural_mode")]
     best = min(counting, key=lambda k: out["laws"][k]["bic"])
+    # a law with fitted parameters must beat the simpler laws by strong evidence: the one-parameter
+    # natural mode the parameter-free counting laws, the two-parameter slip law both (it nests the mode)
+    if out["laws"]["natural_mode"]["bic"] < out["laws"][best]["bic"] - BIC_MARGIN:
+        best = "natural_mode"
     slip_law = out["laws"].get("slip_density_wave")
-    # the two-parameter slip law must beat the best parameter-free counting law by strong evidence
-    if slip_law and slip_law["bic"] < out["laws"][best]["bic"] - BIC_MARGIN:
+    if slip_law and slip_law["bic"] < min(out["laws"][best]["bic"], out["laws"]["natural_mode"]["bic"]) - BIC_MARGIN:
         best = "slip_density_wave"
     if out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE:
-        out["found"] = best
+        if best == "natural_mode" and np.ptp(omega) == 0:
+            # at one wheel speed every counting law is a constant frequency too
+            out["note"] = (f"a constant frequency of {f.mean():.3g} Hz at one wheel speed: a natural mode and a "
+                           "counting law cannot be told apart; vary the wheel speed")
+        else:
+            out["found"] = best
     return out
 
 
@@ -238,9 +255,17 @@ def wheel_counts(geometry) -> tuple[int, int]:
     return int(geometry.grouser_count), int(round(360.0 / geometry.spoke_pitch))
 
 
+def rig_configuration(case) -> str:
+    """The label of what sets a run's natural modes besides the wheel speed and slip: wheel kind, gravity, load."""
+    g = -case.soil.gravity_vector[2]
+    gname = "1g" if abs(g - 9.81) < 0.05 else ("moon" if abs(g - 9.81 / 6) < 0.05 else f"g={g:.3g}")
+    return f"{'rigid' if case.wheel.rigid else 'flexible'} wheel, {gname}, W = {case.test.load:g} N"
+
+
 def periodic_report(folder, quantity: str = "torque", *, report=None, command: str = "") -> dict:
-    """Dominant components of ``quantity`` over the finished runs of a sweep folder, the frequency law that
-    explains them, and a markdown + JSON report in ``report`` (if given)."""
+    """Dominant components of ``quantity`` over the finished runs of a sweep folder and, for each rig
+    configuration (wheel kind, gravity, load: :func:`rig_configuration`), the frequency law that explains
+    them; a markdown + JSON report in ``report`` (if given)."""
     import json
     from pathlib import Path
 
@@ -258,34 +283,50 @@ def periodic_report(folder, quantity: str = "torque", *, report=None, command: s
                                   "compare runs of one wheel")
     grousers, spokes = wheels.pop()
     runs = runs_from_results(results, quantity)
-    found = explain_frequencies(runs, grousers=grousers, spokes=spokes)
-    rows = [{"case": r.name, "omega_rad_s": r.omega, "slip": r.slip, "frequency_hz": r.component.frequency,
-             "amplitude": r.component.amplitude, "p_value": r.component.p_value, "ar1": r.component.ar1,
-             "record_s": r.record_seconds, "cycles": r.cycles, "significant": r.component.significant}
-            for r in sorted(runs, key=lambda r: (r.omega, r.slip, r.name))]
-    out = {"quantity": quantity, "grousers": grousers, "stiffness_peaks_per_turn": spokes, "runs": rows, **found}
+    configs = [rig_configuration(r.case) for r in results]
+    groups = {}
+    for config in sorted(set(configs)):
+        members = [run for run, c in zip(runs, configs) if c == config]
+        groups[config] = explain_frequencies(members, grousers=grousers, spokes=spokes)
+    rows = [{"case": r.name, "configuration": c, "omega_rad_s": r.omega, "slip": r.slip,
+             "frequency_hz": r.component.frequency, "amplitude": r.component.amplitude,
+             "p_value": r.component.p_value, "ar1": r.component.ar1, "record_s": r.record_seconds,
+             "cycles": r.cycles, "significant": r.component.significant}
+            for r, c in sorted(zip(runs, configs), key=lambda rc: (rc[1], rc[0].omega, rc[0].slip, rc[0].name))]
+    out = {"quantity": quantity, "grousers": grousers, "stiffness_peaks_per_turn": spokes, "runs": rows,
+           "configurations": groups}
     if report is not None:
         report = Path(report)
         report.mkdir(parents=True, exist_ok=True)
         with atomic_output(report / "periodic.json") as tmp:
             tmp.write_text(json.dumps(out, indent=1))
-        lines = [f"# Periodic components of {quantity} in {folder.name}", "",
-                 f"Reproduce: `{command}`" if command else "", "",
-                 f"Dominant component of each run's {quantity} over its drive (after the spin-up), tested against "
-                 f"red (AR(1)) noise at p < {SIGNIFICANCE:g}; the wheel has {grousers} grousers and {spokes} "
-                 "stiffness peaks per turn.", "",
-                 "| case | omega [rad/s] | slip | f [Hz] | amplitude | p | AR(1) | cycles in record |",
-                 "|---|---|---|---|---|---|---|---|"]
-        lines += [f"| {r['case']} | {r['omega_rad_s']:g} | {r['slip']:g} | {r['frequency_hz']:.2f} | "
-                  f"{r['amplitude']:.3g} | {r['p_value']:.1e} | {r['ar1']:.2f} | {r['cycles']:.1f} |" for r in rows]
-        lines += ["", "| law | rms relative error | BIC |", "|---|---|---|"]
-        lines += [f"| {k} | {v['rms_relative_error']:.3f} | {v['bic']:.1f} |" for k, v in found["laws"].items()]
-        verdict = (f"**{found['found']}** explains the significant components (within {LAW_TOLERANCE:.0%})."
-                   if found["found"] else
-                   f"No law explains the significant components within {LAW_TOLERANCE:.0%} "
-                   f"({found['significant_runs']} significant runs).")
-        lines += ["", verdict, ""]
+        lines = [f"# Periodic components of {quantity} in {folder.name}", ""]
+        if command:
+            lines += [f"Reproduce: `{command}`", ""]
+        lines += [f"Dominant component of each run's {quantity} over its drive (after the spin-up), tested against "
+                  f"red (AR(1)) noise at p < {SIGNIFICANCE:g}; the wheel has {grousers} grousers and {spokes} "
+                  "stiffness peaks per turn. Laws are compared within each rig configuration (wheel kind, "
+                  "gravity, load), since those set a natural mode.", "",
+                  "| case | configuration | omega [rad/s] | slip | f [Hz] | amplitude | p | AR(1) | cycles |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        lines += [f"| {r['case']} | {r['configuration']} | {r['omega_rad_s']:g} | {r['slip']:g} | "
+                  f"{r['frequency_hz']:.2f} | {r['amplitude']:.3g} | {r['p_value']:.1e} | {r['ar1']:.2f} | "
+                  f"{r['cycles']:.1f} |" for r in rows]
+        for config, found in groups.items():
+            lines += ["", f"## {config}", ""]
+            if found["laws"]:
+                lines += ["| law | rms relative error | BIC | parameters |", "|---|---|---|---|"]
+                lines += [f"| {k} | {v['rms_relative_error']:.3f} | {v['bic']:.1f} | "
+                          + ", ".join(f"{p} = {x:.3g}" for p, x in v["parameters"].items()) + " |"
+                          for k, v in found["laws"].items()]
+            if found["found"]:
+                lines += ["", f"**{found['found']}** explains the significant components (within {LAW_TOLERANCE:.0%})."]
+            elif "note" in found:
+                lines += ["", f"No law named: {found['note']}."]
+            else:
+                lines += ["", f"No law explains them within {LAW_TOLERANCE:.0%} ({found['significant_runs']} "
+                          "significant runs; at least 3 are needed)."]
         with atomic_output(report / "periodic.md") as tmp:
-            tmp.write_text("\n".join(lines))
+            tmp.write_text("\n".join(lines) + "\n")
         out["report"] = str(report / "periodic.md")
     return out
