@@ -324,8 +324,9 @@ def periodic_report(folder, quantity: str = "torque", *, report=None, command: s
             elif "note" in found:
                 lines += ["", f"No law named: {found['note']}."]
             else:
-                lines += ["", f"No law explains them within {LAW_TOLERANCE:.0%} ({found['significant_runs']} "
-                          "significant runs; at least 3 are needed)."]
+                short = "; at least 3 are needed" if found["significant_runs"] < 3 else ""
+                lines += ["", f"No law explains them within {LAW_TOLERANCE:.0%} and beats the simpler laws by "
+                          f"{BIC_MARGIN:g} in BIC ({found['significant_runs']} significant runs{short})."]
         with atomic_output(report / "periodic.md") as tmp:
             tmp.write_text("\n".join(lines) + "\n")
         out["report"] = str(report / "periodic.md")
