@@ -330,7 +330,7 @@ def cmd_batch(args) -> int:
     sweep = load_sweep(args.sweep, args.out)
     if args.list:
         for c in sweep.cases:
-            console.print(f"{c.folder.name}  {'finished' if c.finished else 'to run  '}  {c.name}")
+            print(f"{c.folder.name}  {'finished' if c.finished else 'to run  '}  {c.name}")
         return EXIT_OK
     if args.workers is not None and args.workers < 1:
         raise _InputError(f"--workers {args.workers} must be >= 1")
@@ -594,7 +594,8 @@ def main(argv=None) -> int:
         print(f"wheelsoil {args.command}: simulation stopped: {exc}", file=sys.stderr)
         return EXIT_UNSTABLE
     except KeyboardInterrupt:
-        print(f"wheelsoil {args.command}: interrupted; nothing partial was written", file=sys.stderr)
+        print(f"wheelsoil {args.command}: interrupted; no file that looks finished was written (a run with a "
+              "checkpoint continues with --resume)", file=sys.stderr)
         return 130
 
 

@@ -414,7 +414,7 @@ def load_case(spec: str | Path, overrides=(), *, name: str | None = None) -> Cas
     The case name defaults to the file (or preset) name; ``name`` replaces it.
     """
     path = Path(spec)
-    if path.suffix == ".toml" or path.exists():
+    if path.suffix == ".toml" or path.is_file():
         if not path.is_file():
             raise CaseError(str(path), ["no such case file"])
         text, source, stem = path.read_text(), str(path), path.stem
