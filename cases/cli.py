@@ -363,7 +363,7 @@ def cmd_case(args) -> int:
         raise _InputError("give a case file or preset name ('wheelsoil case list' shows the presets)")
     case = load_case(args.case, args.set or [])
     if args.action == "show":
-        print(case_to_toml(case), end="")
+        print(case_to_toml(case, template=True), end="")
     else:  # check
         print(f"{args.case}: valid; case {case.name}, hash {case.case_hash()}")
     return EXIT_OK

@@ -447,10 +447,12 @@ def _toml_value(value) -> str:
     raise TypeError(f"no TOML form for {value!r}")
 
 
-def case_to_toml(case: CaseFile, *, comments: bool = True) -> str:
+def case_to_toml(case: CaseFile, *, comments: bool = True, template: bool = False) -> str:
     """Every key of ``case`` as TOML (unset optional keys as comments), with units and ranges documented.
 
     ``case_from_toml(case_to_toml(case)) == case`` (the round trip a result file relies on).
+    ``template``: the case name is left as a comment, so that a copy saved as ``my-case.toml`` is named
+    ``my-case`` (what ``wheelsoil case show`` prints).
     """
     lines = [f"# wheelsoil case (schema of wheelsoil {_version()}); every key shown, defaults filled in"]
     for section, model in SECTIONS.items():
@@ -464,6 +466,8 @@ def case_to_toml(case: CaseFile, *, comments: bool = True) -> str:
             note += _limits(section, key, with_unit=False).replace(f"allowed {key} ", "") if comments and note else ""
             if value is None:
                 lines.append(f"# {key} ={note}")
+            elif template and (section, key) == ("case", "name"):
+                lines.append(f"# {key} = {_toml_value(value)}{note}")
             else:
                 lines.append(f"{key} = {_toml_value(value)}{note}")
     return "\n".join(lines) + "\n"

@@ -170,6 +170,7 @@ def test_case_show_from_a_fresh_process_is_a_valid_case_file(tmp_path):
     done = subprocess.run([sys.executable, "-m", "wheelsoil.cases.cli", "case", "show", "smoke-moon-steer"],
                           capture_output=True, text=True, check=True)
     path = write(tmp_path, done.stdout, "copy.toml")
+    assert load_case(path).name == "copy"  # a copy takes its own file name
     assert load_case(path, name="smoke-moon-steer") == load_case("smoke-moon-steer")
 
 
