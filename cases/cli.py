@@ -235,7 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Calibrate the classical wheel-soil model (Wong-Reece, Janosi-Hanamoto, lateral "
                                    "shear) on training conditions, diagnose its residuals, fit every candidate "
                                    "mechanism the data can show (slip-sinkage, theta_m moving with slip, soil flow, "
-                                   "sidewall, grousers, surrogate radius, gravity-scaled cohesion), rank them by "
+                                   "sidewall, grousers, surrogate radius, gravity-scaled cohesion, bulldozing), rank them by "
                                    "held-out error and BIC, and write report.md, findings.json and plots to "
                                    "--report. DATA: a folder of CMU trial files, the digitised single-wheel CSV, a "
                                    "CSV in wheelsoil's format (slip, vertical_load_N, wheel_radius_m, "

@@ -166,3 +166,28 @@ def test_bad_parameters_name_the_key():
         SoilParameters(a1=0.8, a2=0.5)
     with pytest.raises(WheelsoilInputError, match="grouser_height"):
         RigidWheel(radius=0.1, width=0.1, grouser_height=0.2)
+
+
+def test_bulldozing_is_bekkers_passive_pressure_against_travel_only():
+    """R_b = b (0.67 c z K_pc + 0.5 rho g z^2 K_pgamma) with K_pc = (N_c - tan phi) cos^2 phi and
+    K_pgamma = (2 N_gamma / tan phi + 1) cos^2 phi (Bekker; Wong ch. 2): it lowers the drawbar pull by
+    exactly scale x R_b and leaves sinkage, vertical force and torque as they were."""
+    from wheelsoil.validation.terramechanics import bearing_capacity_factors, bulldozing_force
+
+    soil = SoilParameters(density=1500.0, cohesion=1000.0, friction_angle=30.0)
+    wheel = RigidWheel(radius=0.2, width=0.15)
+    z = np.array([0.005, 0.02])
+    n_gamma, n_c, _ = bearing_capacity_factors(30.0)
+    tan, cos2 = np.tan(np.radians(30.0)), np.cos(np.radians(30.0)) ** 2
+    expected = 0.15 * (0.67 * 1000.0 * z * (n_c - tan) * cos2 + 0.5 * 1500.0 * 9.81 * z ** 2 * (2 * n_gamma / tan + 1) * cos2)
+    np.testing.assert_allclose(bulldozing_force(soil, wheel, z, 9.81), expected, rtol=1e-12)
+    # cohesionless: proportional to z^2 and to gravity
+    dry = replace(soil, cohesion=0.0)
+    r1, r2 = bulldozing_force(dry, wheel, z, 9.81), bulldozing_force(dry, wheel, 2 * z, 1.62)
+    np.testing.assert_allclose(r2 / r1, 4.0 * 1.62 / 9.81, rtol=1e-12)
+    kw = dict(slip=np.array([0.1, 0.4]), slip_angle=0.0, load=200.0, gravity=9.81)
+    off, on = predict(soil, wheel, **kw), predict(replace(soil, bulldozing_scale=0.5), wheel, **kw)
+    for q in ("sinkage", "vertical_force", "torque"):
+        np.testing.assert_array_equal(on[q], off[q])
+    np.testing.assert_allclose(off["drawbar_pull"] - on["drawbar_pull"],
+                               0.5 * bulldozing_force(soil, wheel, off["sinkage"], 9.81), rtol=1e-12)

@@ -72,6 +72,7 @@ BASELINE_OFF = {
     "radius_scale": 1.0,
     "grouser_tip_fraction": 0.0,
     "cohesion_gravity_exponent": 0.0,
+    "bulldozing_scale": 0.0,
 }
 
 
@@ -124,6 +125,13 @@ EXTENSIONS = {
             "seed 000 sec. 4 (effective radius R > r, Table 3; eq. 19 without the periodic part)",
             (Parameter("radius_scale", 1.0, 2.0),), {"radius_scale": 1.0},
             lambda d: True,
+        ),
+        Extension(
+            "bulldozing", "soil pushed ahead of the sinking wheel: a passive-pressure resistance against travel",
+            "Bekker / Hegedus 1960 (seed 002 ref. 7; named in seed 003 sec. 3.3.4): R_b = b (0.67 c z K_pc + "
+            "0.5 gamma z^2 K_pgamma)",
+            (Parameter("bulldozing_scale", 0.0, 3.0),), {"bulldozing_scale": 0.0},
+            lambda d: np.isfinite(d.responses["drawbar_pull"]).any(),
         ),
         Extension(
             "gravity_cohesion", "soil strength that falls with gravity (cohesion ~ g^kappa)",

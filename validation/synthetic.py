@@ -30,6 +30,7 @@ HIDDEN_RANGES = {
     "grouser": {"grouser_scale": (1.0, 3.0)},
     "surrogate_radius": {"radius_scale": (1.2, 1.5)},
     "gravity_cohesion": {"cohesion_gravity_exponent": (1.0, 2.0)},
+    "bulldozing": {"bulldozing_scale": (0.15, 0.4)},
 }
 
 

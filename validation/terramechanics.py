@@ -29,6 +29,7 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
 * sidewall resistance (Schwanghart; seed 003 eqs. 17--19, q = 0) on the side the wheel slides towards;
 * grouser forces (seed 003 eq. 20, passive earth pressure on each grouser in the soil, resolved along the
   grouser's angle), spread over the contact as an average over one grouser pitch;
+* bulldozing resistance of the soil pushed ahead of the wheel (Bekker / Hegedus, :func:`bulldozing_force`);
 * sinkage z from vertical equilibrium F_z(z) = W (Illinois false position, vectorised over conditions).
 """
 
@@ -79,6 +80,8 @@ class SoilParameters:
         rim radius.
     cohesion_gravity_exponent: cohesion scales as c (g / 9.81)^kappa (seed 000: soil strength measured at
         reduced gravity is lower); 0: cohesion independent of gravity.
+    bulldozing_scale: factor on the bulldozing resistance of the soil pushed ahead of the sinking wheel
+        (:func:`bulldozing_force`); 0 leaves it out, as seed 003 does (no bulldozed soil seen in MER drives).
     """
 
     density: float = 1600.0
@@ -99,11 +102,13 @@ class SoilParameters:
     radius_scale: float = 1.0
     grouser_tip_fraction: float = 0.0
     cohesion_gravity_exponent: float = 0.0
+    bulldozing_scale: float = 0.0
 
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
             _positive(key, getattr(self, key))
-        for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "grouser_scale", "grouser_tip_fraction"):
+        for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "grouser_scale", "grouser_tip_fraction",
+                    "bulldozing_scale"):
             _positive(key, getattr(self, key), allow_zero=True)
         if not (0.0 < self.friction_angle < 60.0):
             raise WheelsoilInputError(
@@ -212,6 +217,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     f_lateral = r * b * np.sum(weight * tau_y, axis=1)
     if soil.sidewall_scale > 0.0:
         f_lateral = f_lateral + soil.sidewall_scale * sidewall_force(soil, wheel, z, beta, g)
+    if soil.bulldozing_scale > 0.0:
+        fx = fx - soil.bulldozing_scale * bulldozing_force(soil, wheel, z, g, cohesion)
     if wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0:
         gx, gz, gt = grouser_forces(soil, wheel, theta_f, theta_r, g)
         fx = fx + soil.grouser_scale * gx
@@ -255,6 +262,28 @@ def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravi
     integral = np.sum(half[:, None] * w[None, :] * (gamma[:, None] * n_gamma * depth + soil.cohesion * n_c) * depth,
                       axis=1)
     return np.abs(np.sin(beta)) * integral
+
+
+def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None) -> np.ndarray:
+    """Bulldozing resistance of the soil pushed ahead of a wheel sunk by z [N] (magnitude, against travel).
+
+    Bekker's passive-pressure form as Wong (Theory of Ground Vehicles, ch. 2) and Ishigami et al. (2008)
+    give it, after Hegedus (1960; seed 002 ref. 7, named in seed 003 sec. 3.3.4)::
+
+        R_b = b (0.67 c z K_pc + 0.5 gamma z^2 K_pgamma)
+        K_pc = (N_c - tan phi) cos^2 phi,    K_pgamma = (2 N_gamma / tan phi + 1) cos^2 phi
+
+    with the modified Terzaghi factors of seed 003 eq. 18 (:func:`bearing_capacity_factors`) and gamma =
+    rho g. ``cohesion`` overrides the soil's (e.g. gravity-scaled) cohesion per condition.
+    """
+    z = np.asarray(sinkage, float)
+    phi = np.radians(soil.friction_angle)
+    n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
+    k_pc = (n_c - np.tan(phi)) * np.cos(phi) ** 2
+    k_pgamma = (2.0 * n_gamma / np.tan(phi) + 1.0) * np.cos(phi) ** 2
+    c = soil.cohesion if cohesion is None else np.asarray(cohesion, float)
+    gamma = soil.density * np.asarray(gravity, float)
+    return wheel.width * (0.67 * c * z * k_pc + 0.5 * gamma * z * z * k_pgamma)
 
 
 def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gravity):
