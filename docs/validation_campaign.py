@@ -1,7 +1,7 @@
 """Hidden-effect campaign: draw N synthetic datasets, each with one mechanism (or none) hidden at a random
 magnitude, run the discovery workflow on each, and count how often it names the hidden mechanism.
 
-Usage (from the repository root; about 15 s a draw on 2 cores)::
+Usage (from the repository root; under a minute a draw on 2 cores with the nine candidates)::
 
     python docs/validation_campaign.py --seed 11 --draws 16
 """
