@@ -102,6 +102,10 @@ def _spec_from_args(args):
                    diameter_max=v["dmax"], gravity=(0.0, 0.0, -v["gravity"]), seed=v["seed"])
 
 
+def _add_set_option(p: argparse.ArgumentParser, help: str = "override a case key (repeatable)") -> None:
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help=help)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="wheelsoil", description=MAIN_HELP,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -124,9 +128,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "'wheelsoil testbed' is the same command.")
     p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name "
                                                                      "(default smoke-1g-steer)")
-    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
-                   help="override a case key, e.g. --set test.slip=0.5 --set soil.gravity=moon --set "
-                        "'test.drive_time=\"800 ms\"' (repeatable; 'wheelsoil case show' lists the keys)")
+    _add_set_option(p, "override a case key, e.g. --set test.slip=0.5 --set soil.gravity=moon --set "
+                       "'test.drive_time=\"800 ms\"' (repeatable; 'wheelsoil case show' lists the keys)")
     p.add_argument("--slip", type=float, default=None, help="shortcut for --set test.slip=VALUE")
     p.add_argument("--slip-angle", type=float, default=None, help="shortcut for --set test.slip_angle=VALUE [deg]")
     p.add_argument("--load", type=float, default=None, help="shortcut for --set test.load=VALUE [N]")
@@ -147,7 +150,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "'wheelsoil case check CASE' validates a case file and prints its hash.")
     p.add_argument("action", choices=["list", "show", "check"])
     p.add_argument("case", nargs="?", default=None, help="case file (.toml) or preset name")
-    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override a case key (repeatable)")
+    _add_set_option(p)
     p.set_defaults(func=cmd_case)
 
     p = sub.add_parser("batch", help="run a sweep of cases (local processes or a dask cluster); summary and figures",
@@ -180,7 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "options below describe it. Identical beds are reused from the cache "
                                    "(WHEELSOIL_CACHE, default ~/.cache/wheelsoil).")
     p.add_argument("case", nargs="?", default=None, help="case file (.toml) or preset whose bed to prepare")
-    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE", help="override a case key (repeatable)")
+    _add_set_option(p)
     _add_bed_options(p)
     p.add_argument("--out", type=Path, default=Path("bed.h5"), help="bed file to write (default bed.h5)")
     p.set_defaults(func=cmd_prepare_bed)

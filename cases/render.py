@@ -35,37 +35,11 @@ CAMERA_PRESETS = {
 }
 
 
-def render_particles(
-    positions: np.ndarray,
-    radii: np.ndarray,
-    path: str | Path,
-    *,
-    scalars: np.ndarray | None = None,
-    scalar_name: str = "height [m]",
-    box: tuple | None = None,
-    camera: str = "iso",
-    size: tuple[int, int] = (1200, 800),
-    sphere_resolution: int = 12,
-    title: str | None = None,
-    surface: tuple[np.ndarray, np.ndarray] | None = None,
-    surface_scalars: np.ndarray | None = None,
-    surface_scalar_name: str = "wheel deflection [mm]",
-    clim: tuple[float, float] | None = None,
-    surface_clim: tuple[float, float] | None = None,
-) -> Path:
-    """Render spheres (coloured by ``scalars``, default height) to a PNG; returns the path.
-
-    ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline. ``camera`` is one of
-    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a triangulated
-    surface (the wheel): steel grey, or coloured by the nodal ``surface_scalars``. ``clim`` and
-    ``surface_clim`` fix the colour ranges (for animations).
-    """
-    image = render_image(positions, radii, scalars=scalars, scalar_name=scalar_name, box=box, camera=camera,
-                         size=size, sphere_resolution=sphere_resolution, title=title, surface=surface,
-                         surface_scalars=surface_scalars, surface_scalar_name=surface_scalar_name, clim=clim,
-                         surface_clim=surface_clim)
+def render_particles(positions: np.ndarray, radii: np.ndarray, path: str | Path, **view) -> Path:
+    """Render spheres to a PNG (the view keywords of :func:`render_image`); returns the path."""
     import imageio.v3 as iio
 
+    image = render_image(positions, radii, **view)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     iio.imwrite(path, image, extension=".png")
@@ -89,7 +63,13 @@ def render_image(
     clim: tuple[float, float] | None = None,
     surface_clim: tuple[float, float] | None = None,
 ) -> np.ndarray:
-    """The image of :func:`render_particles` as an (H, W, 3) uint8 array."""
+    """Spheres (coloured by ``scalars``, default height) as an (H, W, 3) uint8 image.
+
+    ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline. ``camera`` is one of
+    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a triangulated
+    surface (the wheel): steel grey, or coloured by the nodal ``surface_scalars``. ``clim`` and
+    ``surface_clim`` fix the colour ranges (for animations).
+    """
     import pyvista as pv
 
     if camera not in CAMERA_PRESETS:

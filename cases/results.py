@@ -213,7 +213,8 @@ class Result:
             }
 
 
-def _attr(value):
+def attr_value(value):
+    """An HDF5 attribute as plain Python: bytes to str, NumPy scalars to Python numbers."""
     if isinstance(value, bytes):
         return value.decode()
     if isinstance(value, np.generic):
@@ -237,14 +238,14 @@ def load_result(path: str | Path) -> Result:
         if not f.attrs.get("complete", False):
             raise WheelsoilInputError(f"{path} is not a complete result (the run did not finish)")
         series = {k: f["series"][k][()] for k in f["series"]}
-        units = {k: _attr(f["series"][k].attrs["units"]) for k in f["series"]}
-        sa = {k: _attr(v) for k, v in f["summary"].attrs.items()}
+        units = {k: attr_value(f["series"][k].attrs["units"]) for k in f["series"]}
+        sa = {k: attr_value(v) for k, v in f["summary"].attrs.items()}
         summary = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
                    "samples": int(sa.pop("samples"))}
         for key in [k[:-5] for k in sa if k.endswith("_mean")]:
             summary[key] = {"mean": sa[f"{key}_mean"], "std": sa[f"{key}_std"], "units": sa[f"{key}_units"]}
-        attrs = {k: _attr(v) for k, v in f.attrs.items()}
-        info = {k: _attr(v) for k, v in f["run"].attrs.items()}
+        attrs = {k: attr_value(v) for k, v in f.attrs.items()}
+        info = {k: attr_value(v) for k, v in f["run"].attrs.items()}
         times = np.array([f["frames"][k].attrs["t"] for k in sorted(f["frames"])])
     return Result(path=path, series=series, units=units, summary=summary, attrs=attrs, info=info, frame_times=times)
 

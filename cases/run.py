@@ -27,7 +27,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output, provenance
 
-from .results import ResultWriter, partial_path, rigid_deflection
+from .results import ResultWriter, attr_value, partial_path, rigid_deflection
 from .schema import CaseFile, case_to_toml
 
 RESULT_NAME = "result.h5"
@@ -56,8 +56,7 @@ def _write_tree(group: h5py.Group, tree: dict) -> None:
 
 
 def _read_tree(group: h5py.Group) -> dict:
-    out = {k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
-           for k, v in group.attrs.items()}
+    out = {k: attr_value(v) for k, v in group.attrs.items()}
     for key, item in group.items():
         out[key] = _read_tree(item) if isinstance(item, h5py.Group) else item[()]
     return out
@@ -76,8 +75,7 @@ def load_checkpoint(path: Path) -> tuple[dict, dict]:
     """(state, meta) of a checkpoint file."""
     with h5py.File(path, "r") as f:
         state = _read_tree(f["state"])
-        meta = {k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
-                for k, v in f.attrs.items()}
+        meta = {k: attr_value(v) for k, v in f.attrs.items()}
     return state, meta
 
 

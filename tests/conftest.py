@@ -25,3 +25,17 @@ def measured_dir():
             pytest.fail(f"CI=true but the measured data folder {path} is missing")
         pytest.skip(f"measured data folder {path} not present")
     return path
+
+
+@pytest.fixture(scope="module")
+def bed_cache(tmp_path_factory):
+    """A fresh bed cache for the module's runs, also seen by the ``wheelsoil`` processes they start
+    (``WHEELSOIL_CACHE``); the variable is restored afterwards."""
+    path = tmp_path_factory.mktemp("bed-cache")
+    old = os.environ.get("WHEELSOIL_CACHE")
+    os.environ["WHEELSOIL_CACHE"] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop("WHEELSOIL_CACHE")
+    else:
+        os.environ["WHEELSOIL_CACHE"] = old

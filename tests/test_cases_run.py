@@ -1,7 +1,6 @@
 """One run from a case file: result layout, round trip case -> result -> case, atomic write under a kill,
 resume equal to an uninterrupted run, the XDMF sidecar, renders of frames and animations."""
 
-import os
 import signal
 import subprocess
 import sys
@@ -22,18 +21,6 @@ from wheelsoil.errors import WheelsoilInputError
 #: 0.05 s and checkpoints every 0.1 s.
 MINI = ["test.drive_time=0.15", "output.frame_interval=0.05", "output.checkpoint_interval=0.1",
         "output.render=false"]
-
-
-@pytest.fixture(scope="module")
-def bed_cache(tmp_path_factory):
-    path = tmp_path_factory.mktemp("bed-cache")
-    old = os.environ.get("WHEELSOIL_CACHE")
-    os.environ["WHEELSOIL_CACHE"] = str(path)  # the subprocess runs share it
-    yield path
-    if old is None:
-        os.environ.pop("WHEELSOIL_CACHE")
-    else:
-        os.environ["WHEELSOIL_CACHE"] = old
 
 
 @pytest.fixture(scope="module")

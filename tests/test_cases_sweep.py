@@ -2,7 +2,6 @@
 second run, the summary table and figures, and a sweep on a dask.distributed cluster."""
 
 import json
-import os
 
 import pandas as pd
 import pytest
@@ -14,18 +13,6 @@ from wheelsoil.cases.sweep import load_sweep, run_sweep
 
 COMMON = 'set = { "output.render" = false, "output.frame_interval" = 0.0, "output.checkpoint_interval" = 0.0, ' \
          '"test.drive_time" = 0.1 }'
-
-
-@pytest.fixture(scope="module")
-def bed_cache(tmp_path_factory):
-    path = tmp_path_factory.mktemp("bed-cache")
-    old = os.environ.get("WHEELSOIL_CACHE")
-    os.environ["WHEELSOIL_CACHE"] = str(path)
-    yield path
-    if old is None:
-        os.environ.pop("WHEELSOIL_CACHE")
-    else:
-        os.environ["WHEELSOIL_CACHE"] = old
 
 
 def write(tmp_path, text, name="sweep.toml"):
