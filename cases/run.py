@@ -125,8 +125,8 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
 
     bed = prepare_bed(case.bed_spec(), cache_dir=bed_cache, progress=progress, arch=arch)
     say(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
-    bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
     spec = case.testbed_spec()
+    bench = Testbed(bed, case.wheel_geometry(), spec, arch=arch)
     say(f"wheel {case.wheel.preset}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
         f"{'rigid' if spec.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; slip {spec.slip:g}, "
         f"steering {spec.slip_angle:g} deg, W = {spec.load:g} N")

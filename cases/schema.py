@@ -314,12 +314,11 @@ def _limits(section: str, key: str, *, with_unit: bool = True) -> str:
     field = model.model_fields.get(key) if model else None
     if field is None:
         return ""
-    words = {"Gt": ">", "Ge": ">=", "Lt": "<", "Le": "<="}
     parts = []
     for meta in field.metadata:
         for attr, sym in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
             bound = getattr(meta, attr, None)
-            if bound is not None and type(meta).__name__ in words:
+            if bound is not None:
                 parts.append(f"{sym} {bound:g}")
     unit = (field.json_schema_extra or {}).get("unit")
     text = f"allowed {key} {' and '.join(parts)}" if parts else ""

@@ -137,7 +137,7 @@ def load_sweep(path: str | Path, out: str | Path | None = None) -> Sweep:
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())] if grid else [{}]
     swept = list(dict.fromkeys(list(grid) + [k for r in rows for k in r]))
     base_case = load_case(base)  # validates the base alone first: its errors name the base file
-    base_data = json.loads(case_to_toml_dict(base_case))
+    base_data = base_case.model_dump(mode="json")
     out = Path(out) if out is not None else Path("wheelsoil-output") / "sweeps" / name
     cases, seen = [], {}
     for k, (row, point) in enumerate(itertools.product(rows, points)):
@@ -157,11 +157,6 @@ def load_sweep(path: str | Path, out: str | Path | None = None) -> Sweep:
         seen[h] = k
         cases.append(SweepCase(values=values, case=case, folder=out / "cases" / h))
     return Sweep(name=name, cases=cases, out=out, swept_keys=swept)
-
-
-def case_to_toml_dict(case: CaseFile) -> str:
-    """The case as JSON text of its tables (every key)."""
-    return json.dumps(case.model_dump(mode="json"))
 
 
 # -------------------------------------------------------------------- running
