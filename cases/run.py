@@ -24,6 +24,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output, provenance
 
@@ -165,7 +166,8 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
                                                     "checkpoints": counters["checkpoints"], "t": t})
 
     try:
-        result = bench.run(progress=progress, on_sample=on_sample)
+        with keep_cores_awake(requested_by_environment()):  # opt-in: WHEELSOIL_KEEP_CORES_AWAKE=1
+            result = bench.run(progress=progress, on_sample=on_sample)
         add_frame(bench)
     except BaseException:
         writer.abandon()

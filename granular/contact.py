@@ -100,13 +100,13 @@ def hertz_mindlin(
     if f_t_len2 > f_t_max * f_t_max:
         f_t = f_t * (f_t_max / ti.sqrt(f_t_len2))
         if s_t > 0.0:
-            xi_t = -f_t / s_t
+            xi_t = f_t * (-1.0 / s_t)
 
     # Rolling resistance of the constant-directional-torque type.
     m_roll = vec3(0.0, 0.0, 0.0)
     omega_r = omega_rel - omega_rel.dot(n) * n
     omega_r_len = omega_r.norm()
     if omega_r_len > 0.0:
-        magnitude = ti.min(mu_r * f_elastic * r_eff, inertia_eff * omega_r_len / dt)
-        m_roll = -(magnitude / omega_r_len) * omega_r
+        inv_len = 1.0 / omega_r_len
+        m_roll = -ti.min(mu_r * f_elastic * r_eff * inv_len, inertia_eff / dt) * omega_r
     return -f_normal * n + f_t, n.cross(f_t), m_roll, xi_t

@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 import taichi as ti
 
-from . import forces, integrator, neighbors, runtime
+from . import forces, fused_step, integrator, neighbors, runtime
 from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
 from .materials import (
     LUNAR_SOIL_SIMULANT,
@@ -195,6 +195,9 @@ class Scene:
         self._dt: float | None = None
         self._n_contacts = 0
         self.neighbor_rebuilds = 0
+        #: Run the force pass and the integration as one launch per step when nothing else acts on
+        #: the particles (granular.fused_step; the same arithmetic, fewer passes over memory).
+        self.fuse_steps = True
         # host copy of the state (authoritative while self._dev is None)
         self._x = np.zeros((0, 3))
         self._v = np.zeros((0, 3))
@@ -395,26 +398,55 @@ class Scene:
             raise WheelsoilInputError("the scene has no spheres to step")
         dt = self.time_step
         d = self._to_device()
-        g = self.gravity.tolist()
+        gx, gy, gz = (float(c) for c in self.gravity)
         half_skin2 = (0.5 * d["skin"]) ** 2
+        # Without interactions the force pass, the closing half kick and the next step's opening
+        # kick and drift run as one launch (fused_step), except before a step whose state is read.
+        fused = self.fuse_steps and not self.interactions
+        drifted = False
+        largest = 0.0
         for k in range(n):
-            largest = integrator.kick_drift(
-                d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], g, dt, d["x_ref"]
-            )
+            if not drifted:
+                largest = integrator.kick_drift(
+                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt, d["x_ref"]
+                )
             if largest > half_skin2:
                 self._rebuild_neighbors()
-            for body in self.interactions:
-                body.after_drift(self, dt)
-            self._n_contacts = self._compute_forces(dt)
-            for body in self.interactions:
-                self._n_contacts += int(body.add_forces(self, dt))
-            integrator.kick(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], g, dt)
+            if fused:
+                step_number = self.steps_taken + 1
+                state_read = (
+                    k + 1 == n
+                    or step_number % self.check_interval == 0
+                    or (callback is not None and callback_every and (k + 1) % callback_every == 0)
+                )
+                self._n_contacts, largest = self._contact_step(dt, gx, gy, gz, drift=not state_read)
+                drifted = not state_read
+            else:
+                for body in self.interactions:
+                    body.after_drift(self, dt)
+                self._n_contacts = self._compute_forces(dt)
+                for body in self.interactions:
+                    self._n_contacts += int(body.add_forces(self, dt))
+                integrator.kick(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt)
             self.time += dt
             self.steps_taken += 1
             if self.steps_taken % self.check_interval == 0:
                 self.check_health()
             if callback is not None and callback_every and (k + 1) % callback_every == 0:
                 callback(self)
+
+    def _contact_step(self, dt: float, gx: float, gy: float, gz: float, drift: bool) -> tuple[int, float]:
+        d = self._dev
+        pairs = d["pairs"]
+        n_contacts, largest = fused_step.contact_step(
+            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
+            pairs["i"], pairs["j"], pairs["xi"], d["n_pairs"], pairs["slot"], pairs["touching"],
+            d["gather_start"], d["gather"],
+            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
+            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
+            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"],
+        )
+        return int(n_contacts), float(largest)
 
     def _compute_forces(self, dt: float) -> int:
         d = self._dev
