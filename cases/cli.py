@@ -244,9 +244,11 @@ def build_parser() -> argparse.ArgumentParser:
                                    "CSV in wheelsoil's format (slip, vertical_load_N, wheel_radius_m, "
                                    "wheel_width_m, drawbar_pull_N, ...), a wheelsoil sweep folder (the DEM-FEM "
                                    "runs of 'wheelsoil batch' as data: what the classical model misses of the "
-                                   "simulation), or 'synthetic' (a hidden mechanism, revealed at the end of the "
-                                   "report).")
-    p.add_argument("data", help="measured data (folder or CSV), a sweep folder, or 'synthetic'")
+                                   "simulation), 'synthetic' (a hidden mechanism, revealed at the end of the "
+                                   "report), or 'synthetic-periodic' (drawbar-pull series with a hidden periodic "
+                                   "mechanism: seed 002's density wave or seed 000's spoke-stiffness radius; the "
+                                   "frequency law and the amplitude mechanism are named).")
+    p.add_argument("data", help="measured data (folder or CSV), a sweep folder, 'synthetic' or 'synthetic-periodic'")
     p.add_argument("--model", choices=["semi-empirical"], default="semi-empirical",
                    help="model to hold against the data (default semi-empirical)")
     p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")
@@ -255,7 +257,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(default: a random 30 %% of the conditions)")
     p.add_argument("--responses", nargs="+", default=None,
                    help="responses to fit: drawbar_pull lateral_force sinkage torque (default: those measured)")
-    p.add_argument("--hidden", default=None, help="synthetic only: mechanism to hide, or 'none' (default: random)")
+    p.add_argument("--hidden", default=None, help="synthetic data only: mechanism to hide, or 'none' (default: random)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the hold-out split and synthetic data")
     p.add_argument("--periodic", default=None, metavar="QUANTITY",
                    help="sweep folders: instead of the steady-state model, find the dominant oscillation of QUANTITY "
@@ -270,6 +272,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_validate(args) -> int:
+    if args.data == "synthetic-periodic":
+        from wheelsoil.validation.oscillation import synthetic_periodic_report
+
+        command = "wheelsoil " + " ".join(args.argv)
+        out = synthetic_periodic_report(args.hidden, seed=args.seed, report=args.report, command=command)
+        console = _console()
+        law = out["frequency_law"]
+        console.print(f"frequency law: {law['found'] or 'none'} ({law['significant_runs']} significant runs)")
+        if out["amplitude"]:
+            for k, v in out["amplitude"]["models"].items():
+                gain = f"  gain {v['gain']:+.3f} +- {v['gain_se']:.3f}" if "gain" in v else ""
+                console.print(f"  {k:13s} {v['parameter']} = {v['value']:.4g}  BIC {v['bic']:7.1f}{gain}")
+        console.print(f"found: {out['found'] or 'nothing'}; hidden: {out['hidden']['name'] or 'nothing'} "
+                      f"{out['hidden']['parameters']}")
+        console.print(f"wrote {out['report']}")
+        return EXIT_OK
     if args.periodic:
         from wheelsoil.validation.periodic import periodic_report
 

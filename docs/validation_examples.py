@@ -28,6 +28,15 @@ EXAMPLES = {
                           "miss of the simulation?"),
 }
 
+#: periodic examples: drawbar-pull series with a hidden periodic mechanism (``wheelsoil validate synthetic-periodic``)
+PERIODIC_EXAMPLES = {
+    "synthetic-periodic-density-wave": (["--hidden", "density_wave", "--seed", "1"],
+                                        "seed 002's slip-dependent density wave hidden in red noise"),
+    "synthetic-periodic-spoke-radius": (["--hidden", "spoke_radius", "--seed", "1"],
+                                        "seed 000's spoke-stiffness surrogate radius hidden in red noise"),
+    "synthetic-periodic-nothing": (["--hidden", "none", "--seed", "1"], "red noise only: nothing may be found"),
+}
+
 
 def main() -> int:
     import os
@@ -49,6 +58,24 @@ def main() -> int:
         rows.append(f"| [{name}]({name}/report.md) | {question} | {f['baseline']['heldout_rmse']:.3f} | "
                     + (f"{hit['name']} | {hit['gain']:+.3f} ± {hit['gain_std']:.3f} | {hit['delta_bic']:+.1f} |"
                        if hit else "nothing | – | – |"))
+    rows += ["", "## Periodic effects in time series", "",
+             "| example | question | frequency law | amplitude mechanism | parameter (hidden) | held-out gain in log "
+             "amplitude |", "|---|---|---|---|---|---|"]
+    for name, (extra, question) in PERIODIC_EXAMPLES.items():
+        out = ROOT / "validation" / name
+        argv = ["validate", "synthetic-periodic", "--report", str(out.relative_to(ROOT.parent)), *extra]
+        print("wheelsoil", " ".join(argv), flush=True)
+        if cli(argv) != 0:
+            return 1
+        f = json.loads((out / "findings.json").read_text())
+        law = f["frequency_law"]["found"] or "nothing"
+        if f["found"]:
+            m = f["amplitude"]["models"][f["found"]]
+            truth = ", ".join(f"{k} = {v:.4g}" for k, v in f["hidden"]["parameters"].items())
+            rows.append(f"| [{name}]({name}/report.md) | {question} | {law} | {f['found']} | {m['parameter']} = "
+                        f"{m['value']:.4g} ({truth}) | {m['gain']:+.3f} ± {m['gain_se']:.3f} |")
+        else:
+            rows.append(f"| [{name}]({name}/report.md) | {question} | {law} | nothing | – | – |")
     (ROOT / "validation" / "README.md").write_text("\n".join(rows) + "\n")
     return 0
 

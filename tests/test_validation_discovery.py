@@ -22,7 +22,8 @@ from wheelsoil.validation.synthetic import (
 #: parameters (sidewall, grouser) and the gravity exponent of cohesion trade against cohesion and friction
 #: in their formulas (or saturate: c g^kappa is small at 1/6 g for any kappa > 1), so for them the recovered
 #: quantity is the mechanism's effect on the responses (below).
-DIRECT_TOLERANCE = {"n1": 0.1, "a2": 0.06, "soil_flow": 0.05, "radius_scale": 0.05, "bulldozing_scale": 0.08}
+DIRECT_TOLERANCE = {"n1": 0.1, "a2": 0.06, "soil_flow": 0.05, "radius_scale": 0.05, "bulldozing_scale": 0.08,
+                    "multipass_k2": 0.03}
 #: Relative tolerance of the recovered effect (RMS of the normalised responses the mechanism adds). The
 #: gravity exponent of cohesion saturates (c (1/6)^kappa is small for any kappa > 1) and trades against the
 #: Earth cohesion, so its effect is known to 40 %.
@@ -34,7 +35,7 @@ DEFAULT_EFFECT_TOLERANCE = 0.3
 #: do not change when one is added).
 DRAW_SEEDS = {name: 100 + k for k, name in enumerate(
     ["gravity_cohesion", "grouser", "sidewall", "slip_sinkage", "soil_flow", "surrogate_radius", "theta_m_slip",
-     "bulldozing"])}
+     "bulldozing", "multipass"])}
 
 
 def test_every_hidden_mechanism_has_a_draw_seed():

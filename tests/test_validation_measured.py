@@ -87,3 +87,17 @@ def test_sweep_summary_reads_as_simulated_data_and_a_partial_table_is_refused(tm
     pd.DataFrame([{k: v for k, v in row.items() if k != "wheel_radius"}]).to_csv(path, index=False)
     with pytest.raises(WheelsoilInputError, match=r"not a wheelsoil sweep summary: columns \['wheel_radius'\]"):
         load_measurements(path)
+
+
+def test_wheelsoil_csv_round_trip_keeps_every_condition(tmp_path):
+    """save_measurements / load_generic: conditions (pass number included), wheel and responses come back."""
+    from wheelsoil.validation.measured import load_generic, save_measurements
+    from wheelsoil.validation.synthetic import conditions, synthetic_measurements
+
+    data = synthetic_measurements({}, np.random.default_rng(0), cond=conditions(slips=(0.1, 0.3), slip_angles=(0.0, 10.0)))
+    back = load_generic(save_measurements(data, tmp_path / "m.csv"))
+    for key in ("slip", "slip_angle", "load", "gravity", "passes", "radius", "width", "grouser_height", "grouser_count"):
+        np.testing.assert_allclose(getattr(back, key), getattr(data, key), rtol=1e-9, err_msg=key)
+    assert set(np.unique(back.passes)) == {1.0, 2.0, 3.0}
+    for q in ("drawbar_pull", "lateral_force", "sinkage", "torque"):
+        np.testing.assert_allclose(back.responses[q], data.responses[q], rtol=1e-9, err_msg=q)

@@ -191,3 +191,26 @@ def test_bulldozing_is_bekkers_passive_pressure_against_travel_only():
         np.testing.assert_array_equal(on[q], off[q])
     np.testing.assert_allclose(off["drawbar_pull"] - on["drawbar_pull"],
                                0.5 * bulldozing_force(soil, wheel, off["sinkage"], 9.81), rtol=1e-12)
+
+
+def test_multipass_is_seed003_eq23_compaction_of_density_and_cohesion():
+    """On pass n_p the wheel meets soil of density and cohesion times k1 + k2 n_p with k1 = 1 - k2 (seed 003 eq.
+    23): the model on pass n_p must equal the model on a first pass over soil compacted by that factor, for every
+    force (pressure-sinkage, shear, sidewall, grousers, bulldozing), and the first pass must not change."""
+    soil = replace(SAND, cohesion=800.0, multipass_k2=0.2, sidewall_scale=1.0, grouser_scale=1.0, bulldozing_scale=0.5)
+    wheel = RigidWheel(radius=0.15, width=0.12, grouser_height=0.008, grouser_count=18)
+    kw = dict(slip=np.array([0.1, 0.4, 0.7]), slip_angle=np.array([0.0, 15.0, 30.0]), load=120.0, gravity=9.81)
+    first = predict(soil, wheel, passes=1, **kw)
+    undisturbed = predict(replace(soil, multipass_k2=0.0), wheel, **kw)
+    for q in ("sinkage", "drawbar_pull", "lateral_force", "torque"):
+        np.testing.assert_array_equal(first[q], undisturbed[q])
+    for n_p in (2, 3):
+        factor = 1.0 + 0.2 * (n_p - 1)
+        later = predict(soil, wheel, passes=n_p, **kw)
+        compacted = predict(replace(soil, multipass_k2=0.0, density=SAND.density * factor, cohesion=800.0 * factor),
+                            wheel, **kw)
+        for q in ("sinkage", "drawbar_pull", "lateral_force", "torque"):
+            np.testing.assert_allclose(later[q], compacted[q], rtol=1e-9, err_msg=f"{q}, pass {n_p}")
+        assert np.all(later["sinkage"] < first["sinkage"])  # compacted soil carries the load with less sinkage
+    with pytest.raises(WheelsoilInputError, match=r"passes\[0\] = 0.0 is out of range"):
+        predict(soil, wheel, slip=0.2, load=50.0, passes=0)

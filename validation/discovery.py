@@ -28,7 +28,7 @@ from .terramechanics import RigidWheel, SoilParameters, predict
 BIC_MARGIN = 10.0
 GAIN_SIGMAS = 2.0
 RESPONSES = ("drawbar_pull", "lateral_force", "sinkage", "torque")
-CONDITIONS = ("slip", "slip_angle", "load", "gravity", "grouser_height")
+CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height")
 
 
 def model_responses(soil: SoilParameters, data: Measurements) -> dict[str, np.ndarray]:
@@ -39,7 +39,7 @@ def model_responses(soil: SoilParameters, data: Measurements) -> dict[str, np.nd
         rows = np.all(wheels == key, axis=1)
         wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
         pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
-                       gravity=data.gravity[rows])
+                       gravity=data.gravity[rows], passes=data.passes[rows])
         for q in RESPONSES:
             out[q][rows] = pred[q]
     return out

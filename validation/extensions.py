@@ -73,6 +73,7 @@ BASELINE_OFF = {
     "grouser_tip_fraction": 0.0,
     "cohesion_gravity_exponent": 0.0,
     "bulldozing_scale": 0.0,
+    "multipass_k2": 0.0,
 }
 
 
@@ -132,6 +133,13 @@ EXTENSIONS = {
             "0.5 gamma z^2 K_pgamma)",
             (Parameter("bulldozing_scale", 0.0, 3.0),), {"bulldozing_scale": 0.0},
             lambda d: np.isfinite(d.responses["drawbar_pull"]).any(),
+        ),
+        Extension(
+            "multipass", "soil compacted by the earlier passes of the wheel (or of the wheels ahead of it)",
+            "seed 003 eq. 23 (Senatore & Sandu 2011): gamma_n = gamma_0 (k1 + k2 n_p), cohesion alike, with k1 = 1 - k2 "
+            "(undisturbed soil on the first pass)",
+            (Parameter("multipass_k2", 0.0, 1.0),), {"multipass_k2": 0.0},
+            lambda d: _varies(d.passes),
         ),
         Extension(
             "gravity_cohesion", "soil strength that falls with gravity (cohesion ~ g^kappa)",

@@ -108,8 +108,9 @@ def _is_float(v: str) -> bool:
 class Measurements:
     """Steady-state single-wheel measurements, one row per test (SI; slip_angle in degrees).
 
-    Conditions: slip, slip_angle, load, gravity, and the wheel of each row (radius, width, grouser_height,
-    grouser_count) plus a ``group`` label (e.g. wheel type or source). Responses: ``responses[name]``
+    Conditions: slip, slip_angle, load, gravity, the pass number over the same soil (``passes``, 1 unless
+    given: undisturbed soil), and the wheel of each row (radius, width, grouser_height, grouser_count) plus a
+    ``group`` label (e.g. wheel type or source). Responses: ``responses[name]``
     for drawbar_pull, lateral_force, sinkage, torque (NaN where not measured) and ``std[name]`` where the
     data give a standard deviation. ``sinkage_relative``: the sinkage's zero is not the soil surface
     (e.g. the wheel's start position), so only its changes are comparable with a model.
@@ -129,6 +130,11 @@ class Measurements:
     std: dict[str, np.ndarray] = field(default_factory=dict)
     notes: str = ""
     sinkage_relative: bool = False
+    passes: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.passes is None:
+            self.passes = np.ones(len(self.slip))
 
     def __len__(self) -> int:
         return len(self.slip)
@@ -139,7 +145,7 @@ class Measurements:
         return Measurements(self.name, *(pick(getattr(self, k)) for k in (
             "slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")),
             responses={k: pick(v) for k, v in self.responses.items()}, std={k: pick(v) for k, v in self.std.items()},
-            notes=self.notes, sinkage_relative=self.sinkage_relative)
+            notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes))
 
 
 #: CMU K10-mini wheel (robomechanics/3d-terramechanics parameter files, see the dataset README).
@@ -210,7 +216,7 @@ GENERIC_COLUMNS = {
     "slip": "slip", "slip_angle": "slip_angle_deg", "load": "vertical_load_N", "gravity": "gravity_m_s2",
     "radius": "wheel_radius_m", "width": "wheel_width_m", "grouser_height": "grouser_height_m",
     "grouser_count": "grouser_count", "drawbar_pull": "drawbar_pull_N", "lateral_force": "lateral_force_N",
-    "sinkage": "sinkage_m", "torque": "torque_Nm",
+    "sinkage": "sinkage_m", "torque": "torque_Nm", "passes": "passes",
 }
 
 
@@ -219,8 +225,8 @@ def save_measurements(data: Measurements, path: str | Path) -> Path:
     :func:`load_generic` and by any spreadsheet)."""
     from wheelsoil.provenance import atomic_output
 
-    cols = {GENERIC_COLUMNS[k]: getattr(data, k) for k in ("slip", "slip_angle", "load", "gravity", "radius", "width",
-                                                           "grouser_height", "grouser_count")}
+    cols = {GENERIC_COLUMNS[k]: getattr(data, k) for k in ("slip", "slip_angle", "load", "gravity", "passes", "radius",
+                                                           "width", "grouser_height", "grouser_count")}
     cols |= {GENERIC_COLUMNS[q]: data.responses[q] for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")}
     cols["group"] = data.group
     rows = [",".join(cols)] + [",".join(str(v[k]) if isinstance(v[k], str) else f"{float(v[k]):.10g}"
@@ -232,7 +238,7 @@ def save_measurements(data: Measurements, path: str | Path) -> Path:
 
 def load_generic(path: str | Path, name: str | None = None) -> Measurements:
     """Measurements in wheelsoil's CSV format (see :data:`GENERIC_COLUMNS`; slip, load, wheel radius and width
-    required; slip angle 0, gravity 9.81, smooth wheel and missing responses (NaN) by default)."""
+    required; slip angle 0, gravity 9.81, first pass, smooth wheel and missing responses (NaN) by default)."""
     t = load_table(path)
     t.require("slip", "vertical_load", "wheel_radius", "wheel_width")
     n = len(t)
@@ -243,7 +249,7 @@ def load_generic(path: str | Path, name: str | None = None) -> Measurements:
         width=t.columns["wheel_width"], grouser_height=get("grouser_height", 0.0), grouser_count=get("grouser_count", 0.0),
         group=t.columns["group"] if "group" in t.columns else np.full(n, "all"),
         responses={q: get(q, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
-        notes=f"read from {path}",
+        notes=f"read from {path}", passes=get("passes", 1.0),
     )
 
 

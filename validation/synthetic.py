@@ -31,14 +31,21 @@ HIDDEN_RANGES = {
     "surrogate_radius": {"radius_scale": (1.2, 1.5)},
     "gravity_cohesion": {"cohesion_gravity_exponent": (1.0, 2.0)},
     "bulldozing": {"bulldozing_scale": (0.15, 0.4)},
+    "multipass": {"multipass_k2": (0.1, 0.3)},
 }
 
 
 def conditions(slips=(0.05, 0.15, 0.3, 0.45, 0.6, 0.75), slip_angles=(0.0, 10.0, 20.0, 30.0),
-               loads=(60.0, 120.0), gravities=(9.81, 1.62)):
-    """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2])."""
+               loads=(60.0, 120.0), gravities=(9.81, 1.62), passes=(1, 2, 3)):
+    """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2]), each run on
+    one of ``passes`` (the wheel's pass number over the same soil). The pass number cycles with the sum of the
+    other factors' level indices, a balanced design in which it is not aliased with any one of them, so that
+    adding it costs no extra conditions."""
     grid = np.array(np.meshgrid(slips, slip_angles, loads, gravities, indexing="ij")).reshape(4, -1)
-    return {"slip": grid[0], "slip_angle": grid[1], "load": grid[2], "gravity": grid[3]}
+    levels = np.array(np.meshgrid(*(np.arange(len(v)) for v in (slips, slip_angles, loads, gravities)),
+                                  indexing="ij")).reshape(4, -1).sum(axis=0)
+    n_p = np.asarray(passes, float)[levels % len(passes)]
+    return {"slip": grid[0], "slip_angle": grid[1], "load": grid[2], "gravity": grid[3], "passes": n_p}
 
 
 def draw_hidden_effect(rng: np.random.Generator, names=None) -> tuple[str | None, dict]:
@@ -71,6 +78,76 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
         load=np.asarray(cond["load"], float), gravity=np.asarray(cond["gravity"], float),
         radius=full(wheel.radius), width=full(wheel.width), grouser_height=full(wheel.grouser_height),
         grouser_count=full(wheel.grouser_count), group=np.full(n, "synthetic"), responses=responses,
-        notes=f"hidden: {hidden or 'nothing'}",
+        notes=f"hidden: {hidden or 'nothing'}", passes=np.asarray(cond.get("passes", np.ones(n)), float),
     )
 
+
+
+# ------------------------------------------------------------------------ periodic effects in time series
+#: Periodic mechanisms a synthetic time-series set can hide, with the ranges their parameters are drawn from:
+#: seed 002's density wave (amplitude factor k'_a, and the slip law omega = a + b i of eq. 25 in rad/s) and
+#: seed 000's spoke-stiffness radius (swing dR / r about a surrogate radius of 1.5 r).
+HIDDEN_OSCILLATIONS = {
+    "density_wave": {"k_a": (60.0, 160.0), "a": (30.0, 40.0), "b": (-40.0, -30.0)},
+    "spoke_radius": {"radius_swing": (0.3, 0.9)},
+}
+#: A smooth test wheel [m] for the periodic sets (seed 002's effect is a smooth wheel's).
+SMOOTH_WHEEL = RigidWheel(radius=0.15, width=0.12)
+#: Stiffness peaks per turn of the synthetic flexible wheel (the ExoMars wheel's six, seed 000).
+SYNTHETIC_SPOKES = 6
+
+
+def oscillation_conditions(slips=(0.1, 0.25, 0.4, 0.55), loads=(40.0, 80.0, 160.0), omegas=(1.5, 2.0, 2.5)):
+    """Runs for a periodic set: every slip at every load (a load is a held-out group), the wheel speed cycling
+    through ``omegas`` [rad/s] so that a counting law can be told from a constant frequency."""
+    slip, load = (a.ravel() for a in np.meshgrid(slips, loads, indexing="ij"))
+    omega = np.array([omegas[k % len(omegas)] for k in range(slip.size)], float)
+    return {"slip": slip, "slip_angle": np.zeros(slip.size), "load": load, "gravity": np.full(slip.size, 9.81),
+            "omega": omega}
+
+
+def synthetic_oscillation_series(hidden: str | None, params: dict, rng: np.random.Generator, *,
+                                 soil: SoilParameters = TRUE_SOIL, wheel: RigidWheel = SMOOTH_WHEEL,
+                                 cond: dict | None = None, duration: float = 12.0, rate: float = 100.0,
+                                 noise: float = 0.03, ar1: float = 0.9, quantity: str = "drawbar_pull") -> list:
+    """Drawbar-pull records: the steady value, the ``hidden`` periodic mechanism (None: nothing) and red
+    AR(1) noise of lag-1 correlation ``ar1`` whose standard deviation is ``noise`` times the median steady value.
+
+    ``soil`` is the steady truth; the spoke-radius set uses it with a surrogate radius of 1.5 r.
+    Returns :class:`~wheelsoil.validation.oscillation.SeriesRecord` objects grouped by load.
+    """
+    from .oscillation import SeriesRecord, density_wave_amplitudes, spoke_radius_waveform
+
+    cond = cond or oscillation_conditions()
+    steady_cond = {k: cond[k] for k in ("slip", "slip_angle", "load", "gravity")}
+    if hidden == "spoke_radius":
+        soil = replace(soil, radius_scale=1.5)
+    steady = np.ravel(predict(soil, wheel, **steady_cond)[quantity])
+    t = np.arange(int(duration * rate)) / rate
+    n = steady.size
+    if hidden == "density_wave":
+        amp = density_wave_amplitudes(soil, wheel, steady_cond, params["k_a"], quantity)
+        omega_osc = params["a"] + params["b"] * cond["slip"]  # seed 002 eq. 25 form [rad/s]
+        phase = rng.uniform(0.0, 2.0 * np.pi, n)
+        signal = amp[:, None] * np.sin(omega_osc[:, None] * t[None, :] + phase[:, None])
+    elif hidden == "spoke_radius":
+        phases, values = spoke_radius_waveform(soil, wheel, steady_cond, params["radius_swing"], quantity)
+        coef = np.fft.rfft(values - values.mean(axis=0), axis=0) / values.shape[0]  # trigonometric interpolation
+        angle = SYNTHETIC_SPOKES * cond["omega"][:, None] * t[None, :] + rng.uniform(0, 2 * np.pi, n)[:, None]
+        signal = np.zeros((n, t.size))
+        for k in range(1, coef.shape[0]):
+            weight = 1.0 if 2 * k == values.shape[0] else 2.0
+            signal += weight * np.real(coef[k][:, None] * np.exp(1j * k * angle))
+    elif hidden is None:
+        signal = np.zeros((n, t.size))
+    else:
+        raise ValueError(f"unknown periodic mechanism {hidden!r}; choose one of {sorted(HIDDEN_OSCILLATIONS)}")
+    sigma = noise * float(np.median(np.abs(steady)))
+    innovations = rng.standard_normal((n, t.size)) * sigma * np.sqrt(1.0 - ar1 ** 2)
+    red = np.zeros((n, t.size))
+    red[:, 0] = rng.standard_normal(n) * sigma
+    for k in range(1, t.size):
+        red[:, k] = ar1 * red[:, k - 1] + innovations[:, k]
+    return [SeriesRecord(t, steady[j] + signal[j] + red[j], float(cond["omega"][j]), float(cond["slip"][j]),
+                         float(cond["slip_angle"][j]), float(cond["load"][j]), float(cond["gravity"][j]),
+                         group=f"{cond['load'][j]:g} N") for j in range(n)]

@@ -30,6 +30,9 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
 * grouser forces (seed 003 eq. 20, passive earth pressure on each grouser in the soil, resolved along the
   grouser's angle), spread over the contact as an average over one grouser pitch;
 * bulldozing resistance of the soil pushed ahead of the wheel (Bekker / Hegedus, :func:`bulldozing_force`);
+* multipass compaction: on its n_p-th pass a wheel meets soil compacted by the earlier ones, density and
+  cohesion times k1 + k2 n_p (seed 003 eq. 23, Senatore & Sandu 2011) with k1 = 1 - k2, so that the first
+  pass meets undisturbed soil;
 * sinkage z from vertical equilibrium F_z(z) = W (Illinois false position, vectorised over conditions).
 """
 
@@ -82,6 +85,8 @@ class SoilParameters:
         reduced gravity is lower); 0: cohesion independent of gravity.
     bulldozing_scale: factor on the bulldozing resistance of the soil pushed ahead of the sinking wheel
         (:func:`bulldozing_force`); 0 leaves it out, as seed 003 does (no bulldozed soil seen in MER drives).
+    multipass_k2: compaction per earlier pass: on pass n_p the soil's density and cohesion are 1 + k2 (n_p - 1)
+        times the undisturbed soil's (seed 003 eq. 23 with k1 = 1 - k2); 0: every pass meets undisturbed soil.
     """
 
     density: float = 1600.0
@@ -103,12 +108,13 @@ class SoilParameters:
     grouser_tip_fraction: float = 0.0
     cohesion_gravity_exponent: float = 0.0
     bulldozing_scale: float = 0.0
+    multipass_k2: float = 0.0
 
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
             _positive(key, getattr(self, key))
         for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "grouser_scale", "grouser_tip_fraction",
-                    "bulldozing_scale"):
+                    "bulldozing_scale", "multipass_k2"):
             _positive(key, getattr(self, key), allow_zero=True)
         if not (0.0 < self.friction_angle < 60.0):
             raise WheelsoilInputError(
@@ -149,20 +155,21 @@ class RigidWheel:
             raise WheelsoilInputError(f"grouser_count = {self.grouser_count!r} must be a whole number >= 0")
 
 
-def _conditions(slip, slip_angle, load, gravity):
-    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (slip, slip_angle, load, gravity)))
-    slip, beta_deg, load, gravity = (a.ravel().copy() for a in arrays)
+def _conditions(slip, slip_angle, load, gravity, passes=1.0):
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (slip, slip_angle, load, gravity, passes)))
+    slip, beta_deg, load, gravity, passes = (a.ravel().copy() for a in arrays)
     for name, a, ok, allowed in (
         ("slip", slip, (slip >= -1.0) & (slip < 1.0), "-1 <= slip < 1"),
         ("slip_angle", beta_deg, np.abs(beta_deg) < 90.0, "-90 < slip_angle < 90 deg"),
         ("load", load, load > 0.0, "load > 0 N"),
         ("gravity", gravity, gravity > 0.0, "gravity > 0 m/s^2"),
+        ("passes", passes, passes >= 1.0, "passes >= 1"),
     ):
         bad = ~(np.isfinite(a) & ok)
         if bad.any():
             k = int(np.argmax(bad))
             raise WheelsoilInputError(f"{name}[{k}] = {float(a[k])!r} is out of range: allowed {allowed}")
-    return arrays[0].shape, slip, np.radians(beta_deg), load, gravity
+    return arrays[0].shape, slip, np.radians(beta_deg), load, gravity, passes
 
 
 def _gauss(lo: np.ndarray, hi: np.ndarray, nodes: np.ndarray, weights: np.ndarray):
@@ -171,23 +178,36 @@ def _gauss(lo: np.ndarray, hi: np.ndarray, nodes: np.ndarray, weights: np.ndarra
     return 0.5 * (hi + lo)[:, None] + half * nodes[None, :], half * weights[None, :]
 
 
-def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity) -> dict:
+def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
+    """The radius the contact integrals use [m]: the shearing radius r + lambda h of a grousered wheel times
+    the surrogate-radius scale of a flexible one (both 1 / 0 for the classical rigid wheel)."""
+    return (wheel.radius + soil.grouser_tip_fraction * wheel.grouser_height) * soil.radius_scale
+
+
+def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity,
+                   extra_pressure=0.0, passes=1.0) -> dict:
     """Soil forces on the wheel at a given sinkage (arrays broadcast together; ``slip_angle`` in degrees).
+
+    ``extra_pressure`` [Pa] is added to the normal stress over the whole contact, as seed 002 eq. 17 adds its
+    oscillating term A_gamma sin(omega t + Phi) (:mod:`wheelsoil.validation.oscillation`); 0 by default.
+    ``passes`` is the wheel's pass number n_p over the same soil (1: undisturbed; see ``multipass_k2``).
 
     Returns a dict of 1-D arrays: drawbar_pull, lateral_force, vertical_force, torque [N, N m] and the
     contact angles theta_f, theta_m, theta_r [rad].
     """
-    z, i, beta_deg, g = (a.ravel() for a in np.broadcast_arrays(*(np.asarray(v, float) for v in
-                                                                    (sinkage, slip, slip_angle, gravity))))
+    z, i, beta_deg, g, p_extra, n_p = (a.ravel() for a in np.broadcast_arrays(
+        *(np.asarray(v, float) for v in (sinkage, slip, slip_angle, gravity, extra_pressure, passes))))
     beta = np.radians(beta_deg)
-    r, b = (wheel.radius + soil.grouser_tip_fraction * wheel.grouser_height) * soil.radius_scale, wheel.width
+    r, b = effective_radius(soil, wheel), wheel.width
     phi = np.radians(soil.friction_angle)
-    cohesion = soil.cohesion * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent
+    compaction = 1.0 + soil.multipass_k2 * (n_p - 1.0)  # seed 003 eq. 23 with k1 = 1 - k2
+    density = soil.density * compaction
+    cohesion = soil.cohesion * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
     theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
     theta_m = np.clip(soil.a1 + soil.a2 * i, 0.0, 1.0) * theta_f
     theta_r = -soil.c3 * theta_f
     n = soil.n0 + soil.n1 * np.abs(i)
-    k_pressure = (cohesion * soil.kc_prime + soil.density * g * b * soil.kphi_prime) * (r / b) ** n
+    k_pressure = (cohesion * soil.kc_prime + density * g * b * soil.kphi_prime) * (r / b) ** n
 
     x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
     th_front, w_front = _gauss(theta_m, theta_f, x, w)
@@ -198,6 +218,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     weight = np.concatenate([w_front, w_rear], axis=1)
     stress_angle = np.concatenate([th_front, equivalent], axis=1)
     sigma = k_pressure[:, None] * np.clip(np.cos(stress_angle) - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
+    sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
     tf = theta_f[:, None]
     driving = i[:, None] >= 0.0
@@ -216,11 +237,11 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
     f_lateral = r * b * np.sum(weight * tau_y, axis=1)
     if soil.sidewall_scale > 0.0:
-        f_lateral = f_lateral + soil.sidewall_scale * sidewall_force(soil, wheel, z, beta, g)
+        f_lateral = f_lateral + soil.sidewall_scale * sidewall_force(soil, wheel, z, beta, g, density, cohesion)
     if soil.bulldozing_scale > 0.0:
-        fx = fx - soil.bulldozing_scale * bulldozing_force(soil, wheel, z, g, cohesion)
+        fx = fx - soil.bulldozing_scale * bulldozing_force(soil, wheel, z, g, cohesion, density)
     if wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0:
-        gx, gz, gt = grouser_forces(soil, wheel, theta_f, theta_r, g)
+        gx, gz, gt = grouser_forces(soil, wheel, theta_f, theta_r, g, density, cohesion)
         fx = fx + soil.grouser_scale * gx
         fz = fz + soil.grouser_scale * gz
         torque = torque + soil.grouser_scale * gt
@@ -244,12 +265,23 @@ def bearing_capacity_factors(friction_angle_deg: float) -> tuple[float, float, f
     return float(n_gamma), float(n_c), float(n_q)
 
 
-def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravity) -> np.ndarray:
+def _soil_state(soil: SoilParameters, density, cohesion):
+    """Per-condition density [kg/m^3] and cohesion [Pa]: the soil's, unless given (e.g. gravity-scaled or
+    compacted by earlier passes, as :func:`contact_forces` passes them)."""
+    rho = soil.density if density is None else np.asarray(density, float)
+    c = soil.cohesion if cohesion is None else np.asarray(cohesion, float)
+    return rho, c
+
+
+def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravity, density=None,
+                   cohesion=None) -> np.ndarray:
     """Schwanghart's sidewall resistance (seed 003 eq. 19, surcharge q = 0) [N], magnitude.
 
     F_s = |sin beta| int_{-r sin theta_f}^{r sin theta_f} (gamma N_gamma f(x) + c N_c) f(x) dx with
-    f(x) = sqrt(r^2 - x^2) - r cos theta_f the depth of the sidewall below the surface.
+    f(x) = sqrt(r^2 - x^2) - r cos theta_f the depth of the sidewall below the surface; ``density`` and
+    ``cohesion`` override the soil's per condition.
     """
+    rho, c = _soil_state(soil, density, cohesion)
     r = wheel.radius
     z = np.asarray(sinkage, float)
     n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
@@ -258,13 +290,15 @@ def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravi
     x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
     xs = half[:, None] * x[None, :]
     depth = np.clip(np.sqrt(r * r - xs * xs) - r * np.cos(theta_f)[:, None], 0.0, None)
-    gamma = soil.density * np.asarray(gravity, float)
-    integral = np.sum(half[:, None] * w[None, :] * (gamma[:, None] * n_gamma * depth + soil.cohesion * n_c) * depth,
+    gamma = rho * np.asarray(gravity, float) * np.ones_like(z)
+    c = c * np.ones_like(z)
+    integral = np.sum(half[:, None] * w[None, :] * (gamma[:, None] * n_gamma * depth + c[:, None] * n_c) * depth,
                       axis=1)
     return np.abs(np.sin(beta)) * integral
 
 
-def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None) -> np.ndarray:
+def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None,
+                     density=None) -> np.ndarray:
     """Bulldozing resistance of the soil pushed ahead of a wheel sunk by z [N] (magnitude, against travel).
 
     Bekker's passive-pressure form as Wong (Theory of Ground Vehicles, ch. 2) and Ishigami et al. (2008)
@@ -274,31 +308,31 @@ def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, 
         K_pc = (N_c - tan phi) cos^2 phi,    K_pgamma = (2 N_gamma / tan phi + 1) cos^2 phi
 
     with the modified Terzaghi factors of seed 003 eq. 18 (:func:`bearing_capacity_factors`) and gamma =
-    rho g. ``cohesion`` overrides the soil's (e.g. gravity-scaled) cohesion per condition.
+    rho g. ``cohesion`` and ``density`` override the soil's (e.g. gravity-scaled or compacted) per condition.
     """
     z = np.asarray(sinkage, float)
     phi = np.radians(soil.friction_angle)
     n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
     k_pc = (n_c - np.tan(phi)) * np.cos(phi) ** 2
     k_pgamma = (2.0 * n_gamma / np.tan(phi) + 1.0) * np.cos(phi) ** 2
-    c = soil.cohesion if cohesion is None else np.asarray(cohesion, float)
-    gamma = soil.density * np.asarray(gravity, float)
+    rho, c = _soil_state(soil, density, cohesion)
+    gamma = rho * np.asarray(gravity, float)
     return wheel.width * (0.67 * c * z * k_pc + 0.5 * gamma * z * z * k_pgamma)
 
 
-def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gravity):
+def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gravity, density=None, cohesion=None):
     """Grouser forces (seed 003 eq. 20, surcharge q = 0): passive earth pressure on each grouser in the soil.
 
     A grouser at angle theta carries F_g = b (rho g h^2 N_phi / 2 + 2 c h sqrt(N_phi)) normal to its radial
     face, i.e. tangential to the wheel: forward thrust F_g cos theta and lift F_g sin theta, acting about
     h / 3 inside the tip (seed 003: at about 2/3 of the grouser height), so the motor supplies
     F_g (r + h / 3). Averaged over one grouser pitch, count / (2 pi) grousers per radian of contact arc.
-    Returns (F_x, F_z, T) [N, N, N m].
+    ``density`` and ``cohesion`` override the soil's per condition. Returns (F_x, F_z, T) [N, N, N m].
     """
     h, b, r = wheel.grouser_height, wheel.width, wheel.radius
+    rho, c = _soil_state(soil, density, cohesion)
     n_phi = np.tan(np.pi / 4 + np.radians(soil.friction_angle) / 2) ** 2
-    per_grouser = b * (0.5 * soil.density * np.asarray(gravity, float) * h * h * n_phi
-                       + 2.0 * soil.cohesion * h * np.sqrt(n_phi))
+    per_grouser = b * (0.5 * rho * np.asarray(gravity, float) * h * h * n_phi + 2.0 * c * h * np.sqrt(n_phi))
     per_radian = per_grouser * wheel.grouser_count / (2.0 * np.pi)
     fx = per_radian * (np.sin(theta_f) - np.sin(theta_r))  # int cos(theta) d theta over the contact
     fz = per_radian * (np.cos(theta_r) - np.cos(theta_f))  # int sin(theta) d theta
@@ -306,7 +340,7 @@ def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gr
     return fx, fz, torque
 
 
-def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=9.81,
+def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=9.81, passes=1.0,
             max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10, max_iterations: int = 200) -> dict:
     """Steady-state forces and sinkage for each condition (arrays broadcast together).
 
@@ -316,11 +350,11 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, lo
     lateral_force, vertical_force [N], torque [N m], theta_f, theta_m, theta_r [rad], and ``supported``
     (False where even z = max_sinkage_ratio r cannot carry W; those rows hold that sinkage).
     """
-    shape, i, beta, load, g = _conditions(slip, slip_angle, load, gravity)
+    shape, i, beta, load, g, n_p = _conditions(slip, slip_angle, load, gravity, passes)
     beta_deg = np.degrees(beta)
 
     def excess(z):
-        return contact_forces(soil, wheel, z, i, beta_deg, g)["vertical_force"] - load
+        return contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p)["vertical_force"] - load
 
     lo, f_lo = np.zeros_like(load), -load.copy()
     hi = np.full_like(load, max_sinkage_ratio * wheel.radius)
@@ -348,7 +382,7 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, lo
     else:
         raise RuntimeError(f"sinkage did not converge in {max_iterations} iterations")
     z = np.where(supported, z, max_sinkage_ratio * wheel.radius)
-    out = contact_forces(soil, wheel, z, i, beta_deg, g)
+    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p)
     out["sinkage"] = z
     out["supported"] = supported
     return {k: np.reshape(v, shape) for k, v in out.items()}

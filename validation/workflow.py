@@ -38,7 +38,7 @@ def parse_holdout(spec: str | None, data: Measurements, seed: int) -> np.ndarray
     if spec is None:
         return holdout_mask(data, seed=seed)
     m = re.fullmatch(r"\s*(\w+)\s*=\s*([-+0-9.eE]+|\w+)\s*", spec)
-    conditions = ("slip", "slip_angle", "load", "gravity", "grouser_height", "group")
+    conditions = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height", "group")
     if not m or m.group(1) not in conditions:
         raise WheelsoilInputError(f"--holdout {spec!r}: expected CONDITION=VALUE with CONDITION one of {list(conditions)}")
     key, value = m.group(1), m.group(2)
