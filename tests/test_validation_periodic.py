@@ -151,3 +151,17 @@ def test_a_constant_frequency_at_one_wheel_speed_is_not_named():
     found = explain_frequencies(runs, grousers=24, spokes=12)
     assert found["found"] is None
     assert "vary the wheel speed" in found["note"] and "4.4" in found["note"]
+
+
+def test_a_fitted_law_needs_spare_runs():
+    """Three significant runs lie on some line: the two-parameter slip law is not named from them; with
+    SPARE_RUNS more runs than parameters, a line the frequencies follow is."""
+    from wheelsoil.validation.periodic import SPARE_RUNS, Component, Run, explain_frequencies
+
+    def runs(slips):
+        return [Run(1.0, s, Component(frequency=10.0 + 5.0 * s, amplitude=1.0, phase=0.0, p_value=1e-9, explained=0.5))
+                for s in slips]
+
+    assert explain_frequencies(runs([0.1, 0.4, 0.7]), grousers=24)["found"] is None
+    slips = np.linspace(0.1, 0.7, 2 + SPARE_RUNS)
+    assert explain_frequencies(runs(slips), grousers=24)["found"] == "slip_density_wave"

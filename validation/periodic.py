@@ -36,6 +36,8 @@ SIGNIFICANCE = 1e-3
 LAW_TOLERANCE = 0.05
 #: BIC advantage the two-parameter slip law needs over a parameter-free counting law (strong evidence).
 BIC_MARGIN = 10.0
+#: Significant runs a fitted law needs beyond its parameters (a line through 3 points proves nothing).
+SPARE_RUNS = 3
 
 
 @dataclass
@@ -163,7 +165,8 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
     "significant_runs": n}. A counting law is found when every significant frequency lies within
     :data:`LAW_TOLERANCE` of it; the slip law when it fits with lower BIC than every counting law and its
     relative error is within the same tolerance. Nothing is found without significant components in at
-    least three runs.
+    least three runs, and a fitted law is considered only with :data:`SPARE_RUNS` more significant runs than
+    it has parameters.
     """
     sig = [r for r in runs if r.component.significant]
     out = {"found": None, "laws": {}, "significant_runs": len(sig)}
@@ -183,6 +186,7 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
         out["laws"][name] = {"rms_relative_error": float(np.sqrt(np.mean(rel ** 2))), "parameters": {},
                              "bic": n * np.log(max(np.mean(rel ** 2), 1e-300))}
     rel = (f - f.mean()) / f
+    fitted = {"natural_mode": n >= 1 + SPARE_RUNS, "slip_density_wave": n >= 2 + SPARE_RUNS}
     out["laws"]["natural_mode"] = {
         "rms_relative_error": float(np.sqrt(np.mean(rel ** 2))), "parameters": {"f_hz": float(f.mean())},
         "bic": n * np.log(max(np.mean(rel ** 2), 1e-300)) + np.log(n),
@@ -199,10 +203,11 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
     best = min(counting, key=lambda k: out["laws"][k]["bic"])
     # a law with fitted parameters must beat the simpler laws by strong evidence: the one-parameter
     # natural mode the parameter-free counting laws, the two-parameter slip law both (it nests the mode)
-    if out["laws"]["natural_mode"]["bic"] < out["laws"][best]["bic"] - BIC_MARGIN:
+    if fitted["natural_mode"] and out["laws"]["natural_mode"]["bic"] < out["laws"][best]["bic"] - BIC_MARGIN:
         best = "natural_mode"
     slip_law = out["laws"].get("slip_density_wave")
-    if slip_law and slip_law["bic"] < min(out["laws"][best]["bic"], out["laws"]["natural_mode"]["bic"]) - BIC_MARGIN:
+    if (fitted["slip_density_wave"] and slip_law
+            and slip_law["bic"] < min(out["laws"][best]["bic"], out["laws"]["natural_mode"]["bic"]) - BIC_MARGIN):
         best = "slip_density_wave"
     if out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE:
         if best == "natural_mode" and np.ptp(omega) == 0:
