@@ -249,8 +249,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "mechanism: seed 002's density wave or seed 000's spoke-stiffness radius; the "
                                    "frequency law and the amplitude mechanism are named).")
     p.add_argument("data", help="measured data (folder or CSV), a sweep folder, 'synthetic' or 'synthetic-periodic'")
-    p.add_argument("--model", choices=["semi-empirical"], default="semi-empirical",
-                   help="model to hold against the data (default semi-empirical)")
+    p.add_argument("--model", default="semi-empirical",
+                   help="model to hold against the data: 'semi-empirical' (default: the terramechanics model, "
+                        "calibrated, with the candidate mechanisms) or a wheelsoil sweep folder / summary.csv (the "
+                        "DEM-FEM runs, compared with the measured data condition by condition)")
     p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")
     p.add_argument("--holdout", default=None,
                    help="CONDITION=VALUE: hold out one level, e.g. slip_angle=45 or group=smooth "

@@ -87,11 +87,43 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
     return findings
 
 
+def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, responses=None, group: str | None = None,
+                                command: str = "") -> dict:
+    """``wheelsoil validate DATA --model SWEEP``: the DEM--FEM runs of a sweep as the model, compared with the
+    measured data condition by condition (:mod:`.compare`)."""
+    from .compare import compare, write_comparison_report
+    from .measured import load_sweep_summary
+
+    if data_arg in ("synthetic", "synthetic-periodic"):
+        raise WheelsoilInputError(f"--model {model_arg!r} compares simulations with measured data; DATA {data_arg!r} is "
+                                  "not measured")
+    data = load_measurements(data_arg)
+    if group is not None:
+        rows = np.char.startswith(data.group.astype(str), group)
+        if not rows.any():
+            raise WheelsoilInputError(f"--group {group!r} matches no rows; groups are {sorted(set(map(str, data.group)))}")
+        data = data.select(rows)
+        data.name = f"{data.name} [{group}]"
+    simulated = load_sweep_summary(model_arg)
+    return write_comparison_report(compare(data, simulated, responses), data, simulated, report, command=command)
+
+
 def main_validate(args) -> int:
     from rich.console import Console
 
     console = Console()
     command = "wheelsoil " + " ".join(getattr(args, "argv", None) or sys.argv[1:])
+    if getattr(args, "model", "semi-empirical") != "semi-empirical":
+        f = validate_against_simulation(args.data, args.model, report=args.report, responses=args.responses,
+                                        group=args.group, command=command)
+        console.print(f"{f['pairs']} measured conditions paired with a simulated run ({f['unmatched']} without)")
+        for q, v in f["responses"].items():
+            console.print(f"  {q:14s} bias/spread {v['nbias']:+.3f}  RMS/spread {v['nrmse']:.3f}")
+        for t in f["systematic"]:
+            console.print(f"  systematic: {t['response']} error vs {t['condition']} (Spearman {t['spearman']:+.2f}, "
+                          f"p = {t['p_value']:.1g})")
+        console.print(f"wrote {f['report']}")
+        return 0
     findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
                         hidden=args.hidden, seed=args.seed, group=args.group, command=command)
     base = findings["baseline"]

@@ -1,0 +1,82 @@
+"""DEM-FEM results as the model (validation/compare.py): measured and simulated tests paired condition by condition."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.validation.compare import compare, match_conditions
+from wheelsoil.validation.measured import load_sweep_summary
+from wheelsoil.validation.synthetic import conditions, synthetic_measurements
+
+
+def _as_sweep_summary(m, path, *, offset=0.0, rows=None):
+    """Write measurements in the layout of a wheelsoil sweep's summary.csv (the simulated side)."""
+    rows = np.arange(len(m)) if rows is None else rows
+    table = {"slip_set": m.slip[rows], "slip_angle_set": m.slip_angle[rows], "load_set": m.load[rows],
+             "gravity": m.gravity[rows], "wheel_radius": m.radius[rows], "wheel_width": m.width[rows],
+             "grouser_count": m.grouser_count[rows], "grouser_height": m.grouser_height[rows]}
+    for q, src in (("drawbar_pull", "drawbar_pull"), ("lateral_force", "lateral_force"), ("sinkage", "tread_sinkage"),
+                   ("torque", "torque")):
+        table[f"{src}_mean"] = m.responses[q][rows] + (offset if q == "drawbar_pull" else 0.0)
+        table[f"{src}_std"] = np.full(len(rows), 0.5)
+    path.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(table).to_csv(path / "summary.csv", index=False)
+    return load_sweep_summary(path)
+
+
+def _cond(**kw):
+    return conditions(slips=(0.1, 0.3, 0.5), slip_angles=(0.0, 15.0, 30.0), loads=(60.0, 120.0), gravities=(9.81,),
+                      passes=(1,), **kw)
+
+
+def test_pairs_follow_the_conditions_and_an_offset_is_measured_exactly(tmp_path):
+    measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    # the simulation ran every other condition, in reverse order, 7 N too high in drawbar pull
+    rows = np.arange(len(measured))[::2][::-1]
+    sim = _as_sweep_summary(measured, tmp_path / "sweep", offset=7.0, rows=rows)
+    pairs, unmatched = match_conditions(measured, sim)
+    assert len(pairs) == len(rows) and len(unmatched) == len(measured) - len(rows)
+    np.testing.assert_array_equal(rows[pairs[:, 1]], pairs[:, 0])
+    c = compare(measured, sim)
+    assert c.responses["drawbar_pull"]["bias"] == pytest.approx(7.0, rel=1e-9)
+    assert c.responses["drawbar_pull"]["rmse"] == pytest.approx(7.0, rel=1e-9)
+    for q in ("lateral_force", "torque", "sinkage"):
+        assert c.responses[q]["rmse"] == pytest.approx(0.0, abs=1e-9)
+    assert c.responses["torque"]["within_2sigma"] == 1.0
+
+
+def test_a_simulation_missing_a_mechanism_shows_a_systematic_trend(tmp_path):
+    """The simulation is the classical model; the measurements carry a sidewall resistance that grows with the
+    steering angle: the lateral-force residual must trend with the slip angle, and only there."""
+    cond = _cond()
+    measured = synthetic_measurements({"sidewall_scale": 3.0}, np.random.default_rng(1), cond=cond, noise=0.01,
+                                      relative_noise=0.01)
+    sim = _as_sweep_summary(synthetic_measurements({}, np.random.default_rng(2), cond=cond, noise=0.0,
+                                                   relative_noise=0.0), tmp_path / "sweep")
+    c = compare(measured, sim)
+    top = c.systematic[0]
+    assert (top["response"], top["condition"]) == ("lateral_force", "slip_angle")
+    assert abs(top["spearman"]) > 0.8
+
+
+def test_no_matching_condition_is_refused_with_both_sides_named(tmp_path):
+    measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    sim = _as_sweep_summary(measured, tmp_path / "sweep")
+    sim.radius = sim.radius * 4.0
+    with pytest.raises(WheelsoilInputError, match=r"no measured condition .* it ran \[\(0\.6"):
+        compare(measured, sim)
+
+
+def test_cli_model_sweep_report(tmp_path):
+    from wheelsoil.cases.cli import EXIT_OK, main
+    from wheelsoil.validation.measured import save_measurements
+
+    measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    csv = save_measurements(measured, tmp_path / "measured.csv")
+    _as_sweep_summary(measured, tmp_path / "sweep", offset=3.0)
+    out = tmp_path / "rep"
+    assert main(["validate", str(csv), "--model", str(tmp_path / "sweep"), "--report", str(out)]) == EXIT_OK
+    text = (out / "report.md").read_text()
+    assert "18 measured conditions have a simulated run" in text and "| drawbar_pull | 18 | +3 N |" in text
+    assert (out / "measured_vs_simulated.png").stat().st_size > 1000

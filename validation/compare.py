@@ -1,0 +1,179 @@
+"""DEM--FEM results as *the model*: measured and simulated single-wheel tests compared condition by condition.
+
+``wheelsoil validate DATA --model SWEEP`` holds a batch of wheelsoil runs (a sweep folder or its
+``summary.csv``, read by :func:`~wheelsoil.validation.measured.load_sweep_summary`) against measured data.
+Each measured row is paired with the simulated run at the same conditions -- slip, slip angle, load,
+gravity, pass number -- on the same wheel (radius, width, grouser height); rows without a partner are
+listed, not guessed. For each response the report gives the paired values, the residual simulated -
+measured, its size in combined standard deviations (the measured and the simulated scatter, where known),
+the bias and RMS error normalised by the measured spread, and the Spearman trend of the residual against
+each condition that varies: the same diagnostics the semi-empirical model gets, so a systematic error of
+the simulation (e.g. growing with the steering angle) is named the same way.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import spearmanr
+
+from wheelsoil.errors import WheelsoilInputError
+
+from .measured import Measurements
+
+#: Tolerances within which a measured and a simulated condition are the same test.
+MATCH = {"slip": ("abs", 0.01), "slip_angle": ("abs", 0.5), "load": ("rel", 0.01), "gravity": ("rel", 0.01),
+         "passes": ("abs", 0.01), "radius": ("rel", 0.02), "width": ("rel", 0.02), "grouser_height": ("abs", 1e-4)}
+#: Conditions the residual trends are computed against.
+TREND_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes")
+#: Trend p-value below which a residual trend is reported as systematic.
+TREND_P = 0.01
+
+
+def _same(key: str, a: np.ndarray, b: float) -> np.ndarray:
+    kind, tol = MATCH[key]
+    if kind == "abs":
+        return np.abs(a - b) <= tol
+    return np.abs(a - b) <= tol * np.maximum(np.abs(b), 1e-300)
+
+
+@dataclass
+class Comparison:
+    """Pairs (measured row, simulated row), per-response statistics and trends."""
+
+    pairs: np.ndarray  # (P, 2) row indices into (data, simulated)
+    unmatched: np.ndarray  # measured rows without a simulated partner
+    responses: dict  # name -> {"n", "bias", "rmse", "spread", "nbias", "nrmse", "within_2sigma"}
+    trends: list  # {"response", "condition", "spearman", "p_value"}, strongest first
+
+    @property
+    def systematic(self) -> list:
+        return [t for t in self.trends if t["p_value"] < TREND_P]
+
+
+def match_conditions(data: Measurements, simulated: Measurements) -> tuple[np.ndarray, np.ndarray]:
+    """(pairs, unmatched): each measured row paired with the first simulated row at its conditions."""
+    pairs, unmatched = [], []
+    for k in range(len(data)):
+        ok = np.ones(len(simulated), bool)
+        for key in MATCH:
+            ok &= _same(key, np.asarray(getattr(simulated, key), float), float(getattr(data, key)[k]))
+        hit = np.flatnonzero(ok)
+        if hit.size:
+            pairs.append((k, int(hit[0])))
+        else:
+            unmatched.append(k)
+    return np.array(pairs, int).reshape(-1, 2), np.array(unmatched, int)
+
+
+def _levels(values, digits: int) -> list:
+    return sorted({round(float(v), digits) for v in values})
+
+
+def compare(data: Measurements, simulated: Measurements, responses=None) -> Comparison:
+    """Condition-by-condition comparison of ``simulated`` against ``data`` (see the module docstring)."""
+    pairs, unmatched = match_conditions(data, simulated)
+    if pairs.size == 0:
+        wheels = lambda m: sorted({(float(r), float(w)) for r, w in zip(m.radius, m.width)})  # noqa: E731
+        raise WheelsoilInputError(
+            f"no measured condition of {data.name} has a simulated run in {simulated.name}: the simulation must "
+            f"run the measured wheels {wheels(data)} (radius, width [m]) at their slip, slip angle, load and "
+            f"gravity; it ran {wheels(simulated)} at slips {_levels(simulated.slip, 3)}, slip angles "
+            f"{_levels(simulated.slip_angle, 2)} deg, loads {_levels(simulated.load, 1)} N")
+    responses = responses or [q for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")
+                              if np.isfinite(data.responses[q][pairs[:, 0]]).any()
+                              and np.isfinite(simulated.responses[q][pairs[:, 1]]).any()]
+    stats, trends = {}, []
+    for q in responses:
+        y = data.responses[q][pairs[:, 0]]
+        s = simulated.responses[q][pairs[:, 1]]
+        ok = np.isfinite(y) & np.isfinite(s)
+        if ok.sum() == 0:
+            continue
+        res = s[ok] - y[ok]
+        spread = float(np.std(y[ok])) if ok.sum() > 1 else 0.0
+        spread = spread if spread > 0 else max(float(np.max(np.abs(y[ok]))), 1e-12)
+        sd = np.zeros(ok.sum())
+        for m, col in ((data, 0), (simulated, 1)):
+            if q in m.std:
+                sd = sd + np.nan_to_num(m.std[q][pairs[ok, col]]) ** 2
+        sd = np.sqrt(sd)
+        known = sd > 0
+        stats[q] = {
+            "n": int(ok.sum()), "bias": float(np.mean(res)), "rmse": float(np.sqrt(np.mean(res ** 2))),
+            "spread": spread, "nbias": float(np.mean(res) / spread), "nrmse": float(np.sqrt(np.mean(res ** 2)) / spread),
+            "within_2sigma": (float(np.mean(np.abs(res[known]) <= 2 * sd[known])) if known.any() else None),
+        }
+        for c in TREND_CONDITIONS:
+            x = np.asarray(getattr(data, c), float)[pairs[ok, 0]]
+            if x.size < 4 or np.ptp(x) == 0 or np.ptp(res) == 0:
+                continue
+            rho, p = spearmanr(x, res)
+            trends.append({"response": q, "condition": c, "spearman": float(rho), "p_value": float(p)})
+    trends.sort(key=lambda t: t["p_value"])
+    return Comparison(pairs, unmatched, stats, trends)
+
+
+UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
+
+
+def write_comparison_report(c: Comparison, data: Measurements, simulated: Measurements, out, *, command: str = "") -> dict:
+    """report.md, findings.json and measured_vs_simulated.png in ``out``; returns the findings."""
+    import json
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wheelsoil.provenance import atomic_output, provenance
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    findings = {
+        "data": data.name, "model": simulated.name, "pairs": int(len(c.pairs)), "unmatched": int(len(c.unmatched)),
+        "responses": c.responses, "trends": c.trends, "systematic": c.systematic, "provenance": provenance(),
+    }
+    qs = list(c.responses)
+    fig, axes = plt.subplots(1, len(qs), figsize=(4.2 * len(qs), 4), squeeze=False)
+    for ax, q in zip(axes[0], qs):
+        unit, k = UNITS[q]
+        y = k * data.responses[q][c.pairs[:, 0]]
+        s = k * simulated.responses[q][c.pairs[:, 1]]
+        err = k * simulated.std[q][c.pairs[:, 1]] if q in simulated.std else None
+        ax.errorbar(y, s, yerr=err, fmt="o", ms=4, capsize=2)
+        lim = [np.nanmin(np.r_[y, s]), np.nanmax(np.r_[y, s])]
+        ax.plot(lim, lim, color="0.5", lw=0.8)
+        ax.set_xlabel(f"measured {q.replace('_', ' ')} [{unit}]")
+        ax.set_ylabel(f"simulated [{unit}]")
+    fig.tight_layout()
+    with atomic_output(out / "measured_vs_simulated.png") as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+    lines = [f"# {simulated.name} (DEM-FEM) against {data.name}", ""]
+    if command:
+        lines += [f"Reproduce: `{command}`", ""]
+    lines += [f"{len(c.pairs)} measured conditions have a simulated run at the same slip, slip angle, load, gravity, "
+              f"pass and wheel; {len(c.unmatched)} have none and are left out.", "",
+              "| response | pairs | bias | RMS error | bias / spread | RMS / spread | within 2σ |", "|---|---|---|---|---|---|---|"]
+    for q, v in c.responses.items():
+        unit, k = UNITS[q]
+        within = f"{v['within_2sigma']:.0%}" if v["within_2sigma"] is not None else "–"
+        lines.append(f"| {q} | {v['n']} | {k * v['bias']:+.4g} {unit} | {k * v['rmse']:.4g} {unit} | {v['nbias']:+.3f} | "
+                     f"{v['nrmse']:.3f} | {within} |")
+    lines += ["", "Residual (simulated − measured) trends, Spearman, strongest first:", "",
+              "| response | condition | ρ | p |", "|---|---|---|---|"]
+    lines += [f"| {t['response']} | {t['condition']} | {t['spearman']:+.2f} | {t['p_value']:.1g} |" for t in c.trends[:10]]
+    if c.systematic:
+        lines += ["", "Systematic (p < %g): " % TREND_P + "; ".join(
+            f"{t['response']} error {'grows' if t['spearman'] > 0 else 'falls'} with {t['condition']}" for t in c.systematic)
+            + "."]
+    else:
+        lines += ["", f"No residual trend reaches p < {TREND_P:g}."]
+    lines += ["", "![measured vs simulated](measured_vs_simulated.png)"]
+    with atomic_output(out / "report.md") as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
+    with atomic_output(out / "findings.json") as tmp:
+        tmp.write_text(json.dumps(findings, indent=1))
+    findings["report"] = str(out / "report.md")
+    return findings
