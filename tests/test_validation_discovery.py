@@ -59,6 +59,20 @@ def test_hidden_mechanism_is_named_recovered_and_gains_on_heldout_data(mechanism
     assert found.gain > 0 and found.delta_bic < -10
 
 
+def test_grouser_tip_radius_is_named_in_a_two_wheel_set():
+    """The shearing radius at the grouser tips acts only on a grousered wheel; with one wheel it is the same as a
+    larger radius (the surrogate radius), so it is hidden in a set of the grousered wheel and its smooth twin,
+    as the CMU rig tests both. It must be named over every other candidate, with its fraction recovered."""
+    from wheelsoil.validation.synthetic import TWO_WHEEL_HIDDEN_RANGES, synthetic_two_wheel_measurements
+
+    rng = np.random.default_rng(200)
+    hidden = {k: float(rng.uniform(*b)) for k, b in TWO_WHEEL_HIDDEN_RANGES["grouser_tip_radius"].items()}
+    d = discover(synthetic_two_wheel_measurements(hidden, rng), seed=1)
+    assert d.found is not None and d.found.extension.name == "grouser_tip_radius", hidden
+    assert d.found.fit.free["grouser_tip_fraction"] == pytest.approx(hidden["grouser_tip_fraction"], abs=0.25)
+    assert d.found.gain > 0 and d.found.delta_bic < -10
+
+
 @pytest.mark.parametrize("seed", [7, 8])
 def test_nothing_is_found_where_nothing_is_hidden(seed):
     rng = np.random.default_rng(seed)

@@ -83,6 +83,35 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
 
 
 
+#: The smooth twin of :data:`TEST_WHEEL` (same rim): with both wheels in one set, a mechanism that acts only on
+#: grousers (the shearing radius at the grouser tips) is no longer the same as a larger radius for both.
+SMOOTH_TEST_WHEEL = RigidWheel(radius=TEST_WHEEL.radius, width=TEST_WHEEL.width)
+#: Mechanisms that need the two-wheel set to be told from others, with their hidden ranges.
+TWO_WHEEL_HIDDEN_RANGES = {"grouser_tip_radius": {"grouser_tip_fraction": (0.5, 1.2)}}
+
+
+def two_wheel_conditions():
+    """A smaller factorial per wheel, so that the two-wheel set has as many rows as :func:`conditions`."""
+    return conditions(slips=(0.05, 0.2, 0.4, 0.6), slip_angles=(0.0, 15.0, 30.0))
+
+
+def synthetic_two_wheel_measurements(hidden: dict, rng: np.random.Generator, *, soil: SoilParameters = TRUE_SOIL,
+                                     cond: dict | None = None, **noise) -> Measurements:
+    """:func:`synthetic_measurements` for the grousered :data:`TEST_WHEEL` and its smooth twin at the same
+    conditions, in one set (groups ``grouser`` and ``smooth``), as the CMU rig tests both wheels."""
+    cond = cond or two_wheel_conditions()
+    parts = [synthetic_measurements(hidden, rng, soil=soil, wheel=w, cond=cond, **noise)
+             for w in (TEST_WHEEL, SMOOTH_TEST_WHEEL)]
+    cat = lambda key: np.concatenate([getattr(m, key) for m in parts])  # noqa: E731
+    n = len(parts[0])
+    return Measurements(
+        name="synthetic (two wheels)", slip=cat("slip"), slip_angle=cat("slip_angle"), load=cat("load"),
+        gravity=cat("gravity"), radius=cat("radius"), width=cat("width"), grouser_height=cat("grouser_height"),
+        grouser_count=cat("grouser_count"), group=np.array(["grouser"] * n + ["smooth"] * n),
+        responses={q: np.concatenate([m.responses[q] for m in parts]) for q in parts[0].responses},
+        notes=f"hidden: {hidden or 'nothing'}", passes=cat("passes"),
+    )
+
 # ------------------------------------------------------------------------ periodic effects in time series
 #: Periodic mechanisms a synthetic time-series set can hide, with the ranges their parameters are drawn from:
 #: seed 002's density wave (amplitude factor k'_a, and the slip law omega = a + b i of eq. 25 in rad/s) and
