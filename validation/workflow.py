@@ -45,6 +45,18 @@ def parse_holdout(spec: str | None, data: Measurements, seed: int) -> np.ndarray
     return holdout_mask(data, by=key, level=value if key == "group" else float(value))
 
 
+def select_group(data: Measurements, group: str | None) -> Measurements:
+    """The rows whose group starts with ``group`` (all rows for None), named after it."""
+    if group is None:
+        return data
+    rows = np.char.startswith(data.group.astype(str), group)
+    if not rows.any():
+        raise WheelsoilInputError(f"--group {group!r} matches no rows; groups are {sorted(set(map(str, data.group)))}")
+    data = data.select(rows)
+    data.name = f"{data.name} [{group}]"
+    return data
+
+
 def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
              seed: int = 0, group: str | None = None, command: str = "") -> dict:
     """Load (or synthesise) the data, run discovery, write the report; returns the findings dict."""
@@ -68,12 +80,7 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
         data = load_measurements(data_arg)
         title = f"Validation against {data.name}"
         name = params = None
-    if group is not None:
-        rows = np.char.startswith(data.group.astype(str), group)
-        if not rows.any():
-            raise WheelsoilInputError(f"--group {group!r} matches no rows; groups are {sorted(set(map(str, data.group)))}")
-        data = data.select(rows)
-        data.name = f"{data.name} [{group}]"
+    data = select_group(data, group)
     data, default_responses, excluded = prepare(data)
     mask = parse_holdout(holdout, data, seed)
     d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed)
@@ -98,12 +105,7 @@ def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, 
         raise WheelsoilInputError(f"--model {model_arg!r} compares simulations with measured data; DATA {data_arg!r} is "
                                   "not measured")
     data = load_measurements(data_arg)
-    if group is not None:
-        rows = np.char.startswith(data.group.astype(str), group)
-        if not rows.any():
-            raise WheelsoilInputError(f"--group {group!r} matches no rows; groups are {sorted(set(map(str, data.group)))}")
-        data = data.select(rows)
-        data.name = f"{data.name} [{group}]"
+    data = select_group(data, group)
     simulated = load_sweep_summary(model_arg)
     return write_comparison_report(compare(data, simulated, responses), data, simulated, report, command=command)
 
