@@ -19,6 +19,7 @@ from scipy.stats import spearmanr
 from wheelsoil.errors import WheelsoilInputError
 
 from .measured import Measurements
+from .report import UNITS
 
 #: Tolerances within which a measured and a simulated condition are the same test.
 MATCH = {"slip": ("abs", 0.01), "slip_angle": ("abs", 0.5), "load": ("rel", 0.01), "gravity": ("rel", 0.01),
@@ -111,9 +112,6 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
             trends.append({"response": q, "condition": c, "spearman": float(rho), "p_value": float(p)})
     trends.sort(key=lambda t: t["p_value"])
     return Comparison(pairs, unmatched, stats, trends)
-
-
-UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
 
 
 def write_comparison_report(c: Comparison, data: Measurements, simulated: Measurements, out, *, command: str = "") -> dict:

@@ -83,9 +83,10 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
 
 
 
-#: The smooth twin of :data:`TEST_WHEEL` (same rim): with both wheels in one set, a mechanism that acts only on
-#: grousers (the shearing radius at the grouser tips) is no longer the same as a larger radius for both.
-SMOOTH_TEST_WHEEL = RigidWheel(radius=TEST_WHEEL.radius, width=TEST_WHEEL.width)
+#: The smooth twin of :data:`TEST_WHEEL` (same rim). With both wheels in one set, a mechanism that acts only on
+#: grousers (the shearing radius at the grouser tips) is no longer the same as a larger radius for both; the
+#: periodic sets use it too (seed 002's effect is a smooth wheel's).
+SMOOTH_WHEEL = RigidWheel(radius=TEST_WHEEL.radius, width=TEST_WHEEL.width)
 #: Mechanisms that need the two-wheel set to be told from others, with their hidden ranges.
 TWO_WHEEL_HIDDEN_RANGES = {"grouser_tip_radius": {"grouser_tip_fraction": (0.5, 1.2)}}
 
@@ -101,7 +102,7 @@ def synthetic_two_wheel_measurements(hidden: dict, rng: np.random.Generator, *, 
     conditions, in one set (groups ``grouser`` and ``smooth``), as the CMU rig tests both wheels."""
     cond = cond or two_wheel_conditions()
     parts = [synthetic_measurements(hidden, rng, soil=soil, wheel=w, cond=cond, **noise)
-             for w in (TEST_WHEEL, SMOOTH_TEST_WHEEL)]
+             for w in (TEST_WHEEL, SMOOTH_WHEEL)]
     cat = lambda key: np.concatenate([getattr(m, key) for m in parts])  # noqa: E731
     n = len(parts[0])
     return Measurements(
@@ -120,8 +121,6 @@ HIDDEN_OSCILLATIONS = {
     "density_wave": {"k_a": (60.0, 160.0), "a": (30.0, 40.0), "b": (-40.0, -30.0)},
     "spoke_radius": {"radius_swing": (0.3, 0.9)},
 }
-#: A smooth test wheel [m] for the periodic sets (seed 002's effect is a smooth wheel's).
-SMOOTH_WHEEL = RigidWheel(radius=0.15, width=0.12)
 #: Stiffness peaks per turn of the synthetic flexible wheel (the ExoMars wheel's six, seed 000).
 SYNTHETIC_SPOKES = 6
 
