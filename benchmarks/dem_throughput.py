@@ -158,7 +158,11 @@ def run_liggghts(bed, dt: float, skin: float, steps: int, warmup: int, procs: in
         raise RuntimeError(f"could not find LIGGGHTS loop time in its output:\n{log[-3000:]}")
     wall, nprocs, nsteps, natoms = loops[-1]
     wall, nsteps, natoms = float(wall), int(nsteps), int(natoms)
+    # LIGGGHTS' own split of the timed loop (the last run's "Pair  time (%) = 1.23 (45.6)" lines)
+    sections = {name.strip().lower(): float(t) for name, t in
+                re.findall(r"^(Pair|Neigh|Comm|Outpt|Modify|Other)\s+time \(%\) = ([0-9.eE+-]+)", log, re.M)}
     return {
+        "time_split_s": sections,
         "particles": natoms,
         "procs": int(nprocs),
         "steps": nsteps,

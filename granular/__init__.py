@@ -7,6 +7,7 @@ Public API::
     LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL   seed-004 Table 1 defaults
     estimate_time_step       Rayleigh / Hertz stable-step estimate
     BedSpec, prepare_bed, load_bed, Bed                 soil-bed preparation with an HDF5 cache
+    column_order             particle order for memory locality (prepared beds use it)
 """
 
 from .bed import Bed, BedNotSettledError, BedSpec, load_bed, prepare_bed
@@ -24,6 +25,7 @@ from .materials import (
     effective_shear_modulus,
     restitution_damping_ratio,
 )
+from .ordering import column_order
 from .runtime import init
 from .scene import DeviceState, Interaction, Scene, Wall
 from .timestep import TimeStepEstimate, estimate_time_step
@@ -48,6 +50,7 @@ __all__ = [
     "TimeStepEstimate",
     "Wall",
     "WheelsoilInputError",
+    "column_order",
     "effective_mass",
     "effective_modulus",
     "effective_radius",

@@ -3,8 +3,8 @@
 A velocity-Verlet step (:mod:`.integrator`) is kick--drift, forces, kick. Between two steps nothing
 reads the state when the scene has no interaction (wheel) and no callback or health check is due, so
 the second half kick of step n and the first half kick and drift of step n+1 can run in the same
-particle loop as the force gather of step n. :func:`contact_step` does that: the pair loop and the
-particle loop of :func:`.forces.contact_forces`, then, per particle,
+particle loop as the partner gather of step n. :func:`contact_step` does that: the owner loop and
+the partner loop of :func:`.forces.contact_forces`, then, per particle,
 
     v += dt/2 (F/m + g), omega += dt/2 T/I                 (second half kick of this step)
     and, when ``drift`` is set,
@@ -18,9 +18,9 @@ of Python); :meth:`wheelsoil.granular.Scene.step` uses it whenever it can.
 
 import taichi as ti
 
-from .forces import evaluate_pair, nd_f64_2d, sum_particle_contacts
+from .forces import nd_f64_2d, owner_contacts, partner_contacts
 from .integrator import half_kick
-from .neighbors import nd_f64, nd_i32, nd_mat3, nd_vec3, nd_vec3_2d, vec3
+from .neighbors import nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, vec3
 
 
 @ti.kernel
@@ -31,14 +31,13 @@ def contact_step(
     radius: nd_f64,
     mass: nd_f64,
     inertia: nd_f64,
-    pair_i: nd_i32,
+    pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
-    n_pairs: ti.i32,
-    slot: nd_mat3,
+    pair_rev: nd_i32,
     touching_flag: nd_i32,
-    gather_start: nd_i32,
-    gather: nd_i32,
+    partner_slot: nd_mat23,
+    rev_start: nd_i32,
     wall_point: nd_vec3,
     wall_normal: nd_vec3,
     wall_props: nd_f64_2d,
@@ -62,25 +61,25 @@ def contact_step(
     the next step's first half kick and drift. Returns the number of contacts and the largest squared
     displacement since the last neighbour-list build [m^2] (0 without drift)."""
     n_contacts = 0
-    for p in range(n_pairs):
-        n_contacts += evaluate_pair(
-            p, x, v, omega, radius, mass, inertia, pair_i, pair_j, pair_xi, slot, touching_flag,
-            e_eff, g_eff, beta, mu_s, mu_r, dt,
-        )
-    half = 0.5 * dt
-    gravity = vec3(gx, gy, gz)
-    largest = 0.0
     for i in x:
-        f, t, n_walls = sum_particle_contacts(
-            i, x, v, omega, radius, mass, inertia, slot, touching_flag, gather_start, gather,
-            wall_point, wall_normal, wall_props, xi_wall, wall_touching, dt,
+        f, t, n = owner_contacts(
+            i, x, v, omega, radius, mass, inertia, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
+            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching,
+            e_eff, g_eff, beta, mu_s, mu_r, dt,
         )
         force[i] = f
         torque[i] = t
-        n_contacts += n_walls
-        half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
+        n_contacts += n
+    half = 0.5 * dt
+    gravity = vec3(gx, gy, gz)
+    largest = 0.0
+    for j in x:
+        f, t = partner_contacts(j, rev_start, partner_slot)
+        force[j] += f
+        torque[j] += t
+        half_kick(j, v, omega, force, torque, mass, inertia, gravity, half)
         if drift != 0:
-            half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
-            x[i] += dt * v[i]
-            ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr())
+            half_kick(j, v, omega, force, torque, mass, inertia, gravity, half)
+            x[j] += dt * v[j]
+            ti.atomic_max(largest, (x[j] - x_ref[j]).norm_sqr())
     return n_contacts, largest

@@ -6,8 +6,9 @@ Particles are binned into cubic cells of edge ``cell_size`` >= 2 r_max + skin by
 makes the force summation order -- and hence the result -- independent of the cell size and of the
 thread schedule. From the rows, every pair is listed once (owner i < j) in a compact pair list that
 holds the pair's tangential history; at a rebuild the history moves from the old pair list to the
-new one (a merge of two sorted lists), so contacts survive any number of rebuilds. A gather index
-tells each particle which pairs it takes part in, in row order.
+new one (a merge of two sorted lists), so contacts survive any number of rebuilds. A reverse index
+gives every pair its place in its partner's run of slots (runs by partner, sorted by owner), where
+the force pass writes what the pair exerts on the partner (:mod:`.forces`).
 """
 
 
@@ -15,11 +16,11 @@ import taichi as ti
 
 from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, integrator.py, scene.py)
     ivec3,
-    mat3,
+    mat23,
     nd_f64,
     nd_i32,
     nd_i32_2d,
-    nd_mat3,
+    nd_mat23,
     nd_vec3,
     nd_vec3_2d,
     vec3,
@@ -120,18 +121,20 @@ def build_neighbor_lists(
 
 # ---------------------------------------------------------------------------------------------
 # Pair list: every listed pair once (owner i < j), stored compactly, with its tangential history,
-# and for every particle the pairs it takes part in (the gather index).
+# and the reverse index that lays the partner slots out by partner.
 
 
 @ti.kernel
-def count_owned(nbr: nd_i32_2d, nbr_count: nd_i32, owned: nd_i32):
-    """owned[i] = number of row entries j > i (rows are sorted, so they are the row's tail)."""
+def count_owned(nbr: nd_i32_2d, nbr_count: nd_i32, owned: nd_i32, partnered: nd_i32):
+    """owned[i] = number of row entries j > i (rows are sorted, so they are the row's tail);
+    partnered[i] = the others (the pairs with an owner j < i)."""
     for i in nbr_count:
         c = 0
         for k in range(nbr_count[i]):
             if nbr[i, k] > i:
                 c += 1
         owned[i] = c
+        partnered[i] = nbr_count[i] - c
 
 
 @ti.kernel
@@ -139,7 +142,6 @@ def fill_pairs(
     nbr: nd_i32_2d,
     nbr_count: nd_i32,
     pair_start: nd_i32,
-    pair_i: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
     pair_touching: nd_i32,
@@ -162,7 +164,6 @@ def fill_pairs(
         for k in range(nbr_count[i]):
             j = nbr[i, k]
             if j > i:
-                pair_i[p] = i
                 pair_j[p] = j
                 while a < b and old_j[a] < j:
                     a += 1
@@ -176,27 +177,24 @@ def fill_pairs(
 
 
 @ti.kernel
-def fill_gather_index(
-    nbr: nd_i32_2d, nbr_count: nd_i32, pair_start: nd_i32, pair_j: nd_i32, gather_start: nd_i32, gather: nd_i32
+def fill_reverse_index(
+    nbr: nd_i32_2d, nbr_count: nd_i32, pair_start: nd_i32, pair_j: nd_i32, rev_start: nd_i32, pair_rev: nd_i32
 ):
-    """gather[e] = 2 p for a pair p that particle i owns, 2 p + 1 for one owned by its partner j < i
-    (found by binary search in j's sorted pairs); entries follow the sorted row order."""
-    for i in nbr_count:
-        e = gather_start[i]
-        p_own = pair_start[i]
-        for k in range(nbr_count[i]):
-            j = nbr[i, k]
-            if j > i:
-                gather[e] = 2 * p_own
-                p_own += 1
-            else:
-                lo = pair_start[j]
-                hi = pair_start[j + 1] - 1
+    """pair_rev[p] = the partner slot of pair p: particle j's pairs with owners i < j get the slots
+    rev_start[j], rev_start[j] + 1, ... in the order of j's sorted row (pair p of owner i is found by
+    binary search in i's sorted pairs). Every pair gets exactly one slot, so no two writes collide."""
+    for j in nbr_count:
+        e = rev_start[j]
+        for k in range(nbr_count[j]):
+            i = nbr[j, k]
+            if i < j:
+                lo = pair_start[i]
+                hi = pair_start[i + 1] - 1
                 while lo < hi:
                     mid = (lo + hi) // 2
-                    if pair_j[mid] < i:
+                    if pair_j[mid] < j:
                         lo = mid + 1
                     else:
                         hi = mid
-                gather[e] = 2 * lo + 1
-            e += 1
+                pair_rev[lo] = e
+                e += 1

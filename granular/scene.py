@@ -440,8 +440,8 @@ class Scene:
         pairs = d["pairs"]
         n_contacts, largest = fused_step.contact_step(
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
-            pairs["i"], pairs["j"], pairs["xi"], d["n_pairs"], pairs["slot"], pairs["touching"],
-            d["gather_start"], d["gather"],
+            pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
+            d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
             d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"],
@@ -453,8 +453,8 @@ class Scene:
         pairs = d["pairs"]
         return forces.contact_forces(
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
-            pairs["i"], pairs["j"], pairs["xi"], d["n_pairs"], pairs["slot"], pairs["touching"],
-            d["gather_start"], d["gather"],
+            pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
+            d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
             d["f"], d["t"],
@@ -580,7 +580,8 @@ class Scene:
         d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
         self._alloc_rows(d, width)
         d["owned"] = ti.ndarray(ti.i32, shape=n)
-        d["gather_start"] = ti.ndarray(ti.i32, shape=n + 1)
+        d["partnered"] = ti.ndarray(ti.i32, shape=n)
+        d["rev_start"] = ti.ndarray(ti.i32, shape=n + 1)
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = self._pair_buffers(max(1, len(h["pair_i"])) if h is not None else 1)
         pairs["n_particles"] = 0
@@ -593,7 +594,6 @@ class Scene:
             pairs["touching"].from_numpy(np.any(h["pair_xi"] != 0.0, axis=1).astype(np.int32))
             pairs["n_particles"] = n
         d["pairs"], d["n_pairs"] = pairs, 0
-        d["gather"] = ti.ndarray(ti.i32, shape=1)
         n_walls = len(self.walls)
         d["wall_point"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
         d["wall_normal"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
@@ -634,11 +634,11 @@ class Scene:
         return {
             "capacity": capacity,
             "start": ti.ndarray(ti.i32, shape=n + 1),
-            "i": ti.ndarray(ti.i32, shape=capacity),
             "j": ti.ndarray(ti.i32, shape=capacity),
             "xi": ti.Vector.ndarray(3, ti.f64, shape=capacity),
-            "slot": ti.ndarray(neighbors.mat3, shape=capacity),
             "touching": ti.ndarray(ti.i32, shape=capacity),
+            "rev": ti.ndarray(ti.i32, shape=capacity),
+            "partner_slot": ti.ndarray(neighbors.mat23, shape=capacity),
         }
 
     def _rebuild_neighbors(self) -> None:
@@ -667,20 +667,21 @@ class Scene:
         # The new pair list (owned pairs i < j, compact), with history carried from the current one.
         old = d["pairs"]
         new = d.pop("spare", None) or self._pair_buffers(1)
-        neighbors.count_owned(d["nbr"], d["count"], d["owned"])
+        neighbors.count_owned(d["nbr"], d["count"], d["owned"], d["partnered"])
         n_pairs = neighbors.exclusive_scan(d["owned"], new["start"])
         if n_pairs > new["capacity"]:
             new = self._pair_buffers(int(n_pairs * 1.25) + 16)
             neighbors.exclusive_scan(d["owned"], new["start"])
         neighbors.fill_pairs(
-            d["nbr"], d["count"], new["start"], new["i"], new["j"], new["xi"], new["touching"],
+            d["nbr"], d["count"], new["start"], new["j"], new["xi"], new["touching"],
             old["start"], old["j"], old["xi"], old["touching"], old["n_particles"],
         )
         new["n_particles"] = d["n"]
-        n_entries = neighbors.exclusive_scan(d["count"], d["gather_start"])
-        if n_entries > d["gather"].shape[0]:
-            d["gather"] = ti.ndarray(ti.i32, shape=int(n_entries * 1.25) + 16)
-        neighbors.fill_gather_index(d["nbr"], d["count"], new["start"], new["j"], d["gather_start"], d["gather"])
+        # Partner slots by partner; zero, as the force pass expects of pairs that are apart (a pair
+        # touching now writes its slot in the next force pass).
+        neighbors.exclusive_scan(d["partnered"], d["rev_start"])
+        neighbors.fill_reverse_index(d["nbr"], d["count"], new["start"], new["j"], d["rev_start"], new["rev"])
+        new["partner_slot"].fill(0.0)
         d["pairs"], d["spare"], d["n_pairs"] = new, old, n_pairs
         integrator.copy_vec3(d["x"], d["x_ref"])
         self.neighbor_rebuilds += 1
@@ -693,8 +694,9 @@ class Scene:
         self._x, self._v, self._w = d["x"].to_numpy(), d["v"].to_numpy(), d["w"].to_numpy()
         self._f, self._t = d["f"].to_numpy(), d["t"].to_numpy()
         pairs, n_pairs = d["pairs"], d["n_pairs"]
+        owned = np.diff(pairs["start"].to_numpy())
         self._hist = {
-            "pair_i": pairs["i"].to_numpy()[:n_pairs],
+            "pair_i": np.repeat(np.arange(len(owned), dtype=np.int32), owned),
             "pair_j": pairs["j"].to_numpy()[:n_pairs],
             "pair_xi": pairs["xi"].to_numpy()[:n_pairs],
             "xi_wall": d["xi_wall"].to_numpy()[:, : len(self.walls)],

@@ -4,8 +4,8 @@ import h5py
 import numpy as np
 import pytest
 
-from wheelsoil.granular import BedSpec, WheelsoilInputError, load_bed, prepare_bed
-from wheelsoil.granular.bed import bed_cache_path
+from wheelsoil.granular import BedSpec, WheelsoilInputError, column_order, load_bed, prepare_bed
+from wheelsoil.granular.bed import bed_cache_path, measure_packing_fraction
 
 TINY = dict(length=0.16, width=0.1, depth=0.06)
 
@@ -87,3 +87,40 @@ def test_bad_bed_spec_is_named(change, fragment):
 def test_missing_bed_file_is_named(tmp_path):
     with pytest.raises(WheelsoilInputError, match="does not exist"):
         load_bed(tmp_path / "nope.h5")
+
+
+@pytest.mark.parametrize("height_cells", [1, 2, 5])
+def test_packing_fraction_of_a_simple_cubic_lattice_is_pi_over_6(height_cells):
+    """Touching spheres on a simple cubic lattice fill pi/6 of space. The core region is a whole
+    number of lattice cells, as short as one cell, and the estimate must be exact for each."""
+    a = 0.02  # lattice spacing = diameter [m]
+    spec = BedSpec(length=12 * a, width=9 * a, depth=0.1, diameter_min=a, diameter_max=a)
+    # region [a, L - a] x [a, W - a] x [a, surface - a]: 10 x 7 x height_cells lattice cells
+    surface = (2 + height_cells) * a
+    # centres offset by 0.3 a from the region's faces so none lies on a boundary
+    n = (12, 9, 3 + height_cells)
+    idx = np.stack(np.meshgrid(*[np.arange(k) for k in n], indexing="ij"), -1).reshape(-1, 3)
+    positions = (idx + 0.3) * a
+    radii = np.full(len(positions), a / 2)
+    assert measure_packing_fraction(positions, radii, spec, surface) == pytest.approx(np.pi / 6, rel=1e-12)
+
+
+def test_column_order_groups_spheres_into_columns():
+    rng = np.random.default_rng(3)
+    positions = rng.uniform([0, 0, 0], [0.5, 0.2, 0.1], (2000, 3))
+    perm = column_order(positions, 0.05)
+    assert sorted(perm) == list(range(len(positions)))  # a permutation
+    p = positions[perm]
+    # columns (counted from the lowest x and y) are contiguous runs, bottom to top; the shorter
+    # side (y) varies fastest
+    col = np.floor((p[:, :2] - positions[:, :2].min(axis=0)) / 0.05).astype(int)
+    key = col[:, 0] * 1000 + col[:, 1]
+    assert np.all(np.diff(key) >= 0)
+    same = np.diff(key) == 0
+    assert np.all(np.diff(p[:, 2])[same] > 0)
+    # applying it to ordered positions gives the identity
+    assert np.array_equal(column_order(p, 0.05), np.arange(len(p)))
+    with pytest.raises(ValueError, match="cell"):
+        column_order(positions, 0.0)
+    with pytest.raises(ValueError, match="shape"):
+        column_order(positions[:, :2], 0.05)
