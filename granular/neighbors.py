@@ -1,14 +1,14 @@
 """Uniform-grid neighbour search with Verlet lists that carry contact history across rebuilds.
 
 Particles are binned into cubic cells of edge ``cell_size`` >= 2 r_max + skin by a counting sort
-(integer atomics only), then every particle gathers the partners within r_i + r_j + skin from the
-27 surrounding cells into its own row of a fixed-width list. Rows are sorted by partner index, which
-makes the force summation order -- and hence the result -- independent of the cell size and of the
-thread schedule. From the rows, every pair is listed once (owner i < j) in a compact pair list that
-holds the pair's tangential history; at a rebuild the history moves from the old pair list to the
-new one (a merge of two sorted lists), so contacts survive any number of rebuilds. A reverse index
-gives every pair its place in its partner's run of slots (runs by partner, sorted by owner), where
-the force pass writes what the pair exerts on the partner (:mod:`.forces`).
+(integer atomics only), then every particle gathers the partners j > i within r_i + r_j + skin from
+the 27 surrounding cells into its own row of a fixed-width list (each pair once: its owner is the
+lower index). Rows are sorted by partner index, which makes the force summation order -- and hence
+the result -- independent of the cell size and of the thread schedule. The rows become a compact
+pair list that holds each pair's tangential history; at a rebuild the history moves from the old
+pair list to the new one (a merge of two sorted lists), so contacts survive any number of rebuilds.
+A reverse index gives every pair its place in its partner's run of slots (runs by partner, sorted
+by owner), where the force pass writes what the pair exerts on the partner (:mod:`.forces`).
 """
 
 
@@ -81,7 +81,7 @@ def build_neighbor_lists(
     nbr: nd_i32_2d,
     nbr_count: nd_i32,
 ) -> ti.i32:
-    """Fill each particle's row with partners j != i closer than r_i + r_j + skin, sorted by j.
+    """Fill each particle's row with the partners j > i closer than r_i + r_j + skin, sorted by j.
 
     Returns the largest number of partners found for one particle; when it exceeds the row width
     the rows are truncated and the caller must widen them and call again.
@@ -99,7 +99,7 @@ def build_neighbor_lists(
                 cid = (cc[2] * dims[1] + cc[1]) * dims[0] + cc[0]
                 for s in range(cell_start[cid], cell_start[cid + 1]):
                     j = sorted_ids[s]
-                    if j != i:
+                    if j > i:
                         reach = ri + radius[j] + skin
                         if (x[j] - xi).norm_sqr() < reach * reach:
                             if count < width:
@@ -125,19 +125,6 @@ def build_neighbor_lists(
 
 
 @ti.kernel
-def count_owned(nbr: nd_i32_2d, nbr_count: nd_i32, owned: nd_i32, partnered: nd_i32):
-    """owned[i] = number of row entries j > i (rows are sorted, so they are the row's tail);
-    partnered[i] = the others (the pairs with an owner j < i)."""
-    for i in nbr_count:
-        c = 0
-        for k in range(nbr_count[i]):
-            if nbr[i, k] > i:
-                c += 1
-        owned[i] = c
-        partnered[i] = nbr_count[i] - c
-
-
-@ti.kernel
 def fill_pairs(
     nbr: nd_i32_2d,
     nbr_count: nd_i32,
@@ -151,9 +138,9 @@ def fill_pairs(
     old_touching: nd_i32,
     n_old_particles: ti.i32,
 ):
-    """Write the owned pairs of every particle from its sorted row, carrying each pair's history
-    and touching flag from the previous pair list (a merge of two sorted lists); new pairs start
-    at zero, untouched."""
+    """Write the pairs of every particle (its sorted row of partners j > i) into the pair list,
+    carrying each pair's history and touching flag from the previous pair list (a merge of two
+    sorted lists); new pairs start at zero, untouched."""
     for i in nbr_count:
         p = pair_start[i]
         a = 0
@@ -163,38 +150,50 @@ def fill_pairs(
             b = old_start[i + 1]
         for k in range(nbr_count[i]):
             j = nbr[i, k]
-            if j > i:
-                pair_j[p] = j
-                while a < b and old_j[a] < j:
-                    a += 1
-                if a < b and old_j[a] == j:
-                    pair_xi[p] = old_xi[a]
-                    pair_touching[p] = old_touching[a]
-                else:
-                    pair_xi[p] = vec3(0.0, 0.0, 0.0)
-                    pair_touching[p] = 0
-                p += 1
+            pair_j[p] = j
+            while a < b and old_j[a] < j:
+                a += 1
+            if a < b and old_j[a] == j:
+                pair_xi[p] = old_xi[a]
+                pair_touching[p] = old_touching[a]
+            else:
+                pair_xi[p] = vec3(0.0, 0.0, 0.0)
+                pair_touching[p] = 0
+            p += 1
+
+
+@ti.kernel
+def count_partners(pair_j: nd_i32, n_pairs: ti.i32, partnered: nd_i32):
+    """partnered[j] = number of pairs with partner j (owners i < j)."""
+    for j in partnered:
+        partnered[j] = 0
+    for p in range(n_pairs):
+        ti.atomic_add(partnered[pair_j[p]], 1)
 
 
 @ti.kernel
 def fill_reverse_index(
-    nbr: nd_i32_2d, nbr_count: nd_i32, pair_start: nd_i32, pair_j: nd_i32, rev_start: nd_i32, pair_rev: nd_i32
+    pair_j: nd_i32, n_pairs: ti.i32, rev_start: nd_i32, cursor: nd_i32, rev_pair: nd_i32, pair_rev: nd_i32
 ):
-    """pair_rev[p] = the partner slot of pair p: particle j's pairs with owners i < j get the slots
-    rev_start[j], rev_start[j] + 1, ... in the order of j's sorted row (pair p of owner i is found by
-    binary search in i's sorted pairs). Every pair gets exactly one slot, so no two writes collide."""
-    for j in nbr_count:
-        e = rev_start[j]
-        for k in range(nbr_count[j]):
-            i = nbr[j, k]
-            if i < j:
-                lo = pair_start[i]
-                hi = pair_start[i + 1] - 1
-                while lo < hi:
-                    mid = (lo + hi) // 2
-                    if pair_j[mid] < j:
-                        lo = mid + 1
-                    else:
-                        hi = mid
-                pair_rev[lo] = e
-                e += 1
+    """pair_rev[p] = the partner slot of pair p: the pairs with partner j get the slots rev_start[j],
+    rev_start[j] + 1, ... in the order of their owners. Pairs are listed by owner, so that is
+    ascending p: each run is filled in any order (integer atomics on ``cursor``) and then sorted,
+    which makes the index independent of the thread schedule. ``rev_pair`` is the inverse map."""
+    for j in cursor:
+        cursor[j] = 0
+    for p in range(n_pairs):
+        j = pair_j[p]
+        rev_pair[rev_start[j] + ti.atomic_add(cursor[j], 1)] = p
+    for j in cursor:
+        lo = rev_start[j]
+        hi = rev_start[j + 1]
+        # insertion sort of the (short) run
+        for a in range(lo + 1, hi):
+            key = rev_pair[a]
+            b = a - 1
+            while b >= lo and rev_pair[b] > key:
+                rev_pair[b + 1] = rev_pair[b]
+                b -= 1
+            rev_pair[b + 1] = key
+        for e in range(lo, hi):
+            pair_rev[rev_pair[e]] = e

@@ -579,8 +579,8 @@ class Scene:
         d["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
         d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
         self._alloc_rows(d, width)
-        d["owned"] = ti.ndarray(ti.i32, shape=n)
         d["partnered"] = ti.ndarray(ti.i32, shape=n)
+        d["cursor"] = ti.ndarray(ti.i32, shape=n)
         d["rev_start"] = ti.ndarray(ti.i32, shape=n + 1)
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = self._pair_buffers(max(1, len(h["pair_i"])) if h is not None else 1)
@@ -638,6 +638,7 @@ class Scene:
             "xi": ti.Vector.ndarray(3, ti.f64, shape=capacity),
             "touching": ti.ndarray(ti.i32, shape=capacity),
             "rev": ti.ndarray(ti.i32, shape=capacity),
+            "rev_pair": ti.ndarray(ti.i32, shape=capacity),
             "partner_slot": ti.ndarray(neighbors.mat23, shape=capacity),
         }
 
@@ -660,18 +661,19 @@ class Scene:
         if most > d["width"] or 2 * fitted < d["width"]:
             # Rows too narrow, or far wider than needed (wide rows waste cache): refit them.
             if fitted > 4096:
-                raise CapacityError(f"a particle has {most} neighbours; the size ratio or skin is unreasonable")
+                raise CapacityError(
+                    f"a particle has {most} neighbours with higher indices; the size ratio or skin is unreasonable"
+                )
             self._alloc_rows(d, fitted)
             build_rows()
 
-        # The new pair list (owned pairs i < j, compact), with history carried from the current one.
+        # The new pair list (the rows, compact), with history carried from the current one.
         old = d["pairs"]
         new = d.pop("spare", None) or self._pair_buffers(1)
-        neighbors.count_owned(d["nbr"], d["count"], d["owned"], d["partnered"])
-        n_pairs = neighbors.exclusive_scan(d["owned"], new["start"])
+        n_pairs = neighbors.exclusive_scan(d["count"], new["start"])
         if n_pairs > new["capacity"]:
             new = self._pair_buffers(int(n_pairs * 1.25) + 16)
-            neighbors.exclusive_scan(d["owned"], new["start"])
+            neighbors.exclusive_scan(d["count"], new["start"])
         neighbors.fill_pairs(
             d["nbr"], d["count"], new["start"], new["j"], new["xi"], new["touching"],
             old["start"], old["j"], old["xi"], old["touching"], old["n_particles"],
@@ -679,8 +681,9 @@ class Scene:
         new["n_particles"] = d["n"]
         # Partner slots by partner; zero, as the force pass expects of pairs that are apart (a pair
         # touching now writes its slot in the next force pass).
+        neighbors.count_partners(new["j"], n_pairs, d["partnered"])
         neighbors.exclusive_scan(d["partnered"], d["rev_start"])
-        neighbors.fill_reverse_index(d["nbr"], d["count"], new["start"], new["j"], d["rev_start"], new["rev"])
+        neighbors.fill_reverse_index(new["j"], n_pairs, d["rev_start"], d["cursor"], new["rev_pair"], new["rev"])
         new["partner_slot"].fill(0.0)
         d["pairs"], d["spare"], d["n_pairs"] = new, old, n_pairs
         integrator.copy_vec3(d["x"], d["x_ref"])

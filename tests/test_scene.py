@@ -144,6 +144,31 @@ def test_results_independent_of_cell_size_and_skin():
     np.testing.assert_array_equal(wide_skin.angular_velocities, ref.angular_velocities)
 
 
+def test_pair_list_matches_brute_force_and_partner_runs_are_sorted():
+    """The pair list holds exactly the pairs within r_i + r_j + skin at the last rebuild, each once
+    (owner i < j, partners ascending), and the reverse index gives every pair one partner slot, in
+    runs by partner with owners ascending."""
+    x, r, v = random_packing()
+    s = run_packing(x, r, v, steps=400)
+    d, pairs, n_pairs = s._dev, s._dev["pairs"], s._dev["n_pairs"]
+    assert s.neighbor_rebuilds >= 2
+    owners = np.repeat(np.arange(s.n_particles), np.diff(pairs["start"].to_numpy()))
+    partners = pairs["j"].to_numpy()[:n_pairs]
+    x_ref = d["x_ref"].to_numpy()
+    dist = np.linalg.norm(x_ref[:, None, :] - x_ref[None, :, :], axis=-1)
+    ii, jj = np.nonzero(np.triu(dist < r[:, None] + r[None, :] + d["skin"], k=1))
+    np.testing.assert_array_equal(owners, ii)  # np.nonzero lists row-major: owner, then partner
+    np.testing.assert_array_equal(partners, jj)
+    rev = pairs["rev"].to_numpy()[:n_pairs]
+    assert np.array_equal(np.sort(rev), np.arange(n_pairs))
+    by_slot = np.empty(n_pairs, dtype=np.int64)
+    by_slot[rev] = np.arange(n_pairs)  # the pair in each slot
+    rev_start = d["rev_start"].to_numpy()
+    np.testing.assert_array_equal(np.repeat(np.arange(s.n_particles), np.diff(rev_start)), partners[by_slot])
+    same_run = np.diff(partners[by_slot]) == 0
+    assert np.all(np.diff(owners[by_slot])[same_run] > 0)
+
+
 def test_fused_step_follows_the_separate_kernels():
     """Scenes without interactions run forces and integration as one launch per step
     (granular.fused_step); the operations and their order are those of the separate kick--drift,
