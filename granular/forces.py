@@ -55,6 +55,7 @@ def owner_contacts(
     wall_props: ti.template(),
     xi_wall: ti.template(),
     wall_touching: ti.template(),
+    wall_near: ti.template(),
     e_eff,
     g_eff,
     beta,
@@ -69,7 +70,9 @@ def owner_contacts(
     M_r on i. The tangential force acts at distance r from each centre, so i receives
     r_i (n x F_t) + M_r and j receives -F and r_j (n x F_t) - M_r. ``wall_touching[i]`` is a bit
     mask of the walls particle i touched at the last step, so a wall history is cleared once on
-    separation rather than every step.
+    separation rather than every step; ``wall_near[i]`` the mask of the walls within reach since
+    the last rebuild (:func:`.neighbors.near_walls`). Only walls in either mask are checked: most
+    particles of a bed are far from every wall and skip the loop.
     """
     xi_pos = x[i]
     ri = radius[i]
@@ -120,35 +123,40 @@ def owner_contacts(
             pair_xi[p] = vec3(0.0, 0.0, 0.0)
             partner_slot[pair_rev[p]] = mat23([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
     mask = wall_touching[i]
+    candidates = mask | wall_near[i]
     new_mask = 0
-    for w in range(wall_point.shape[0]):
-        nw = wall_normal[w]
-        gap = (xi_pos - wall_point[w]).dot(nw)
-        if gap < ri:
-            n = -nw
-            fc, tw, m_roll, xi_new = hertz_mindlin(
-                n,
-                ri - gap,
-                vi + wi.cross(ri * n),
-                wi,
-                ri,
-                mi,
-                ii,
-                wall_props[w, WALL_E_EFF],
-                wall_props[w, WALL_G_EFF],
-                wall_props[w, WALL_BETA],
-                wall_props[w, WALL_MU_S],
-                wall_props[w, WALL_MU_R],
-                xi_wall[i, w],
-                dt,
-            )
-            xi_wall[i, w] = xi_new
-            f += fc
-            t += ri * tw + m_roll
-            n_contacts += 1
-            new_mask |= 1 << w
-        elif (mask >> w) & 1:
-            xi_wall[i, w] = vec3(0.0, 0.0, 0.0)
+    n_walls = 0
+    if candidates != 0:
+        n_walls = wall_point.shape[0]
+    for w in range(n_walls):
+        if (candidates >> w) & 1:
+            nw = wall_normal[w]
+            gap = (xi_pos - wall_point[w]).dot(nw)
+            if gap < ri:
+                n = -nw
+                fc, tw, m_roll, xi_new = hertz_mindlin(
+                    n,
+                    ri - gap,
+                    vi + wi.cross(ri * n),
+                    wi,
+                    ri,
+                    mi,
+                    ii,
+                    wall_props[w, WALL_E_EFF],
+                    wall_props[w, WALL_G_EFF],
+                    wall_props[w, WALL_BETA],
+                    wall_props[w, WALL_MU_S],
+                    wall_props[w, WALL_MU_R],
+                    xi_wall[i, w],
+                    dt,
+                )
+                xi_wall[i, w] = xi_new
+                f += fc
+                t += ri * tw + m_roll
+                n_contacts += 1
+                new_mask |= 1 << w
+            elif (mask >> w) & 1:
+                xi_wall[i, w] = vec3(0.0, 0.0, 0.0)
     if new_mask != mask:
         wall_touching[i] = new_mask
     return f, t, n_contacts
@@ -187,6 +195,7 @@ def contact_forces(
     wall_props: nd_f64_2d,
     xi_wall: nd_vec3_2d,
     wall_touching: nd_i32,
+    wall_near: nd_i32,
     e_eff: ti.f64,
     g_eff: ti.f64,
     beta: ti.f64,
@@ -204,7 +213,7 @@ def contact_forces(
     for i in x:
         f, t, n = owner_contacts(
             i, x, v, omega, radius, mass, inertia, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
-            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching,
+            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
             e_eff, g_eff, beta, mu_s, mu_r, dt,
         )
         force[i] = f

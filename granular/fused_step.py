@@ -43,6 +43,7 @@ def contact_step(
     wall_props: nd_f64_2d,
     xi_wall: nd_vec3_2d,
     wall_touching: nd_i32,
+    wall_near: nd_i32,
     e_eff: ti.f64,
     g_eff: ti.f64,
     beta: ti.f64,
@@ -64,7 +65,7 @@ def contact_step(
     for i in x:
         f, t, n = owner_contacts(
             i, x, v, omega, radius, mass, inertia, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
-            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching,
+            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
             e_eff, g_eff, beta, mu_s, mu_r, dt,
         )
         force[i] = f

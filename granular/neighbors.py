@@ -9,6 +9,8 @@ pair list that holds each pair's tangential history; at a rebuild the history mo
 pair list to the new one (a merge of two sorted lists), so contacts survive any number of rebuilds.
 A reverse index gives every pair its place in its partner's run of slots (runs by partner, sorted
 by owner), where the force pass writes what the pair exerts on the partner (:mod:`.forces`).
+Walls get a list of their own at each rebuild: a bit mask per particle of the walls within reach
+(:func:`near_walls`).
 """
 
 
@@ -117,6 +119,22 @@ def build_neighbor_lists(
         nbr_count[i] = kept
         ti.atomic_max(most, count)
     return most
+
+
+@ti.kernel
+def near_walls(x: nd_vec3, radius: nd_f64, wall_point: nd_vec3, wall_normal: nd_vec3, skin: ti.f64, wall_near: nd_i32):
+    """wall_near[i] = bit mask of the planar walls w whose signed distance to particle i's centre,
+    (x_i - p_w) . n_w, is below r_i + skin: the only walls i can touch before the next rebuild,
+    since no particle moves more than skin / 2 in between (walls do not move). The force pass
+    checks just these instead of every wall for every particle."""
+    for i in x:
+        xi = x[i]
+        reach = radius[i] + skin
+        mask = 0
+        for w in range(wall_point.shape[0]):
+            if (xi - wall_point[w]).dot(wall_normal[w]) < reach:
+                mask |= 1 << w
+        wall_near[i] = mask
 
 
 # ---------------------------------------------------------------------------------------------

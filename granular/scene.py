@@ -442,7 +442,7 @@ class Scene:
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
-            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
+            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
             d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"],
         )
@@ -455,7 +455,7 @@ class Scene:
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
-            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"],
+            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
             d["f"], d["t"],
         )
@@ -616,6 +616,7 @@ class Scene:
             d["xi_wall"].from_numpy(np.ascontiguousarray(h["xi_wall"]))
             touching = np.any(h["xi_wall"] != 0.0, axis=2)  # (n, walls)
             d["wall_touching"].from_numpy((touching * (1 << np.arange(n_walls))).sum(axis=1).astype(np.int32))
+        d["wall_near"] = ti.ndarray(ti.i32, shape=n)
         d["health"] = ti.ndarray(ti.f64, shape=4)
         self._dev = d
         self._rebuild_neighbors()
@@ -686,6 +687,7 @@ class Scene:
         neighbors.fill_reverse_index(new["j"], n_pairs, d["rev_start"], d["cursor"], new["rev_pair"], new["rev"])
         new["partner_slot"].fill(0.0)
         d["pairs"], d["spare"], d["n_pairs"] = new, old, n_pairs
+        neighbors.near_walls(d["x"], d["r"], d["wall_point"], d["wall_normal"], d["skin"], d["wall_near"])
         integrator.copy_vec3(d["x"], d["x_ref"])
         self.neighbor_rebuilds += 1
 

@@ -169,6 +169,25 @@ def test_pair_list_matches_brute_force_and_partner_runs_are_sorted():
     assert np.all(np.diff(owners[by_slot])[same_run] > 0)
 
 
+def test_wall_list_holds_the_walls_within_reach():
+    """At each rebuild every particle lists the walls within r_i + skin of its centre (the force
+    pass checks only those); a particle touching a wall has it listed."""
+    x, r, v = random_packing()
+    s = run_packing(x, r, v)  # settled: many particles rest on the floor and walls
+    d = s._dev
+    assert s.neighbor_rebuilds >= 2
+    points = np.array([w.point for w in s.walls])
+    normals = np.array([w.normal for w in s.walls])
+    gap = np.einsum("iwk,wk->iw", d["x_ref"].to_numpy()[:, None, :] - points[None], normals)
+    expected = ((gap < r[:, None] + d["skin"]) * (1 << np.arange(len(s.walls)))).sum(axis=1)
+    near = d["wall_near"].to_numpy()
+    np.testing.assert_array_equal(near, expected)
+    touching = d["wall_touching"].to_numpy()
+    assert np.count_nonzero(touching) > 10
+    assert np.all(touching & ~near == 0)
+    assert 0 < np.count_nonzero(near) < s.n_particles
+
+
 def test_fused_step_follows_the_separate_kernels():
     """Scenes without interactions run forces and integration as one launch per step
     (granular.fused_step); the operations and their order are those of the separate kick--drift,
