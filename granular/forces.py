@@ -22,12 +22,17 @@ partner slots by owner index) makes results deterministic and independent of the
 This layout replaced one that stored the force on the owner in a slot per pair and gathered every
 slot through an index: the owner's share now stays in registers, and only the partner's share
 (48 of 72 bytes per pair) goes through memory, read back in order (benchmarks/README.md).
+
+The particles' state comes from the *contact view* that every drift writes
+(:func:`.integrator.write_contact_view`): (x, r), (v, m) and (omega, I) as 4-vectors, so a
+partner's state is three 32-byte reads rather than six scattered ones, and the distance check
+touches one of them.
 """
 
 import taichi as ti
 
 from .contact import hertz_mindlin
-from .neighbors import mat23, nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, vec3
+from .neighbors import mat23, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
 nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -38,12 +43,9 @@ WALL_E_EFF, WALL_G_EFF, WALL_BETA, WALL_MU_S, WALL_MU_R = range(5)
 @ti.func
 def owner_contacts(
     i,
-    x: ti.template(),
-    v: ti.template(),
-    omega: ti.template(),
-    radius: ti.template(),
-    mass: ti.template(),
-    inertia: ti.template(),
+    x_r: ti.template(),
+    v_m: ti.template(),
+    w_i: ti.template(),
     pair_start: ti.template(),
     pair_j: ti.template(),
     pair_xi: ti.template(),
@@ -74,31 +76,37 @@ def owner_contacts(
     the last rebuild (:func:`.neighbors.near_walls`). Only walls in either mask are checked: most
     particles of a bed are far from every wall and skip the loop.
     """
-    xi_pos = x[i]
-    ri = radius[i]
-    mi = mass[i]
-    ii = inertia[i]
-    vi = v[i]
-    wi = omega[i]
+    own_x = x_r[i]
+    own_v = v_m[i]
+    own_w = w_i[i]
+    xi_pos = own_x.xyz
+    ri = own_x[3]
+    vi = own_v.xyz
+    mi = own_v[3]
+    wi = own_w.xyz
+    ii = own_w[3]
     f = vec3(0.0, 0.0, 0.0)
     t = vec3(0.0, 0.0, 0.0)
     n_contacts = 0
     for p in range(pair_start[i], pair_start[i + 1]):
         j = pair_j[p]
-        d = x[j] - xi_pos
-        rj = radius[j]
+        other_x = x_r[j]
+        d = other_x.xyz - xi_pos
+        rj = other_x[3]
         reach = ri + rj
         dist2 = d.norm_sqr()
         if dist2 < reach * reach:
             dist = ti.sqrt(dist2)
             n = d * (1.0 / dist)
-            mj = mass[j]
-            ij = inertia[j]
-            wj = omega[j]
+            other_v = v_m[j]
+            other_w = w_i[j]
+            mj = other_v[3]
+            ij = other_w[3]
+            wj = other_w.xyz
             fc, tn, m_roll, xi_new = hertz_mindlin(
                 n,
                 reach - dist,
-                vi + wi.cross(ri * n) - (v[j] + wj.cross(-rj * n)),
+                vi + wi.cross(ri * n) - (other_v.xyz + wj.cross(-rj * n)),
                 wi - wj,
                 ri * rj / reach,
                 mi * mj / (mi + mj),
@@ -177,12 +185,9 @@ def partner_contacts(j, rev_start: ti.template(), partner_slot: ti.template()):
 
 @ti.kernel
 def contact_forces(
-    x: nd_vec3,
-    v: nd_vec3,
-    omega: nd_vec3,
-    radius: nd_f64,
-    mass: nd_f64,
-    inertia: nd_f64,
+    x_r: nd_vec4,
+    v_m: nd_vec4,
+    w_i: nd_vec4,
     pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
@@ -210,16 +215,16 @@ def contact_forces(
     over owners (:func:`owner_contacts`), then over partners (:func:`partner_contacts`).
     """
     n_contacts = 0
-    for i in x:
+    for i in x_r:
         f, t, n = owner_contacts(
-            i, x, v, omega, radius, mass, inertia, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
+            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
             partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
             e_eff, g_eff, beta, mu_s, mu_r, dt,
         )
         force[i] = f
         torque[i] = t
         n_contacts += n
-    for j in x:
+    for j in x_r:
         f, t = partner_contacts(j, rev_start, partner_slot)
         force[j] += f
         torque[j] += t

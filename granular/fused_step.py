@@ -9,6 +9,7 @@ the partner loop of :func:`.forces.contact_forces`, then, per particle,
     v += dt/2 (F/m + g), omega += dt/2 T/I                 (second half kick of this step)
     and, when ``drift`` is set,
     v += dt/2 (F/m + g), omega += dt/2 T/I, x += dt v      (first half kick and drift of the next)
+    and the contact view of the new state (:func:`.integrator.write_contact_view`)
 
 with the same Taichi functions and in the same order as the separate kernels, so the trajectory is the
 velocity-Verlet one. It saves two passes over the particle arrays and two kernel launches per step
@@ -19,8 +20,8 @@ of Python); :meth:`wheelsoil.granular.Scene.step` uses it whenever it can.
 import taichi as ti
 
 from .forces import nd_f64_2d, owner_contacts, partner_contacts
-from .integrator import half_kick
-from .neighbors import nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, vec3
+from .integrator import half_kick, write_contact_view
+from .neighbors import nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
 
 @ti.kernel
@@ -57,14 +58,18 @@ def contact_step(
     gz: ti.f64,
     drift: ti.i32,
     x_ref: nd_vec3,
+    x_r: nd_vec4,
+    v_m: nd_vec4,
+    w_i: nd_vec4,
 ) -> (ti.i32, ti.f64):
-    """Contact forces at the current positions, the step's second half kick and, if ``drift`` != 0,
-    the next step's first half kick and drift. Returns the number of contacts and the largest squared
+    """Contact forces at the current positions (read from the contact view ``x_r``, ``v_m``,
+    ``w_i``), the step's second half kick and, if ``drift`` != 0, the next step's first half kick and
+    drift, which also refresh the contact view. Returns the number of contacts and the largest squared
     displacement since the last neighbour-list build [m^2] (0 without drift)."""
     n_contacts = 0
     for i in x:
         f, t, n = owner_contacts(
-            i, x, v, omega, radius, mass, inertia, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
+            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
             partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
             e_eff, g_eff, beta, mu_s, mu_r, dt,
         )
@@ -82,5 +87,6 @@ def contact_step(
         if drift != 0:
             half_kick(j, v, omega, force, torque, mass, inertia, gravity, half)
             x[j] += dt * v[j]
+            write_contact_view(j, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
             ti.atomic_max(largest, (x[j] - x_ref[j]).norm_sqr())
     return n_contacts, largest

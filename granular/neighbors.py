@@ -25,7 +25,9 @@ from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, i
     nd_mat23,
     nd_vec3,
     nd_vec3_2d,
+    nd_vec4,
     vec3,
+    vec4,
 )
 
 

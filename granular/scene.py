@@ -408,7 +408,8 @@ class Scene:
         for k in range(n):
             if not drifted:
                 largest = integrator.kick_drift(
-                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt, d["x_ref"]
+                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt, d["x_ref"],
+                    d["r"], d["x_r"], d["v_m"], d["w_i"],
                 )
             if largest > half_skin2:
                 self._rebuild_neighbors()
@@ -444,7 +445,7 @@ class Scene:
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"],
+            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"],
         )
         return int(n_contacts), float(largest)
 
@@ -452,7 +453,7 @@ class Scene:
         d = self._dev
         pairs = d["pairs"]
         return forces.contact_forces(
-            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
+            d["x_r"], d["v_m"], d["w_i"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
@@ -573,6 +574,9 @@ class Scene:
         d["r"] = scal(self._r)
         d["m"] = scal(mass)
         d["I"] = scal(0.4 * mass * self._r**2)
+        # the contact view: (x, r), (v, m), (omega, I) side by side for the force pass
+        d["x_r"], d["v_m"], d["w_i"] = (ti.Vector.ndarray(4, ti.f64, shape=max(n, 1)) for _ in range(3))
+        integrator.contact_view(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["x_r"], d["v_m"], d["w_i"])
         n_cells = int(np.prod(dims))
         d["cell_of"] = ti.ndarray(ti.i32, shape=n)
         d["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)

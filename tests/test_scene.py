@@ -215,6 +215,12 @@ def test_fused_step_follows_the_separate_kernels():
     np.testing.assert_allclose(fused.contact_forces, separate.contact_forces, rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(seen[True], seen[False], rtol=1e-9)
     assert len(seen[True]) == 6
+    # the contact view the force pass reads is written by the drift of either path
+    for s in scenes.values():
+        x_r = s._dev["x_r"].to_numpy()
+        np.testing.assert_array_equal(x_r[:, :3], s.positions)
+        np.testing.assert_array_equal(x_r[:, 3], s.radii)
+        np.testing.assert_array_equal(s._dev["v_m"].to_numpy()[:, 3], s.masses)
 
 
 def test_contact_history_survives_rebuilds_and_edits():
