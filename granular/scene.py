@@ -439,15 +439,16 @@ class Scene:
     def _contact_step(self, dt: float, gx: float, gy: float, gz: float, drift: bool) -> tuple[int, float]:
         d = self._dev
         pairs = d["pairs"]
-        n_contacts, largest = fused_step.contact_step(
+        fused_step.contact_step_graph(
             d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"],
+            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
         )
-        return int(n_contacts), float(largest)
+        result = d["step_result"]
+        return int(result[0]), float(result[1])
 
     def _compute_forces(self, dt: float) -> int:
         d = self._dev
@@ -622,6 +623,7 @@ class Scene:
             d["wall_touching"].from_numpy((touching * (1 << np.arange(n_walls))).sum(axis=1).astype(np.int32))
         d["wall_near"] = ti.ndarray(ti.i32, shape=n)
         d["health"] = ti.ndarray(ti.f64, shape=4)
+        d["step_result"] = ti.ndarray(ti.f64, shape=2)
         self._dev = d
         self._rebuild_neighbors()
         return d
