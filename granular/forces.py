@@ -31,8 +31,10 @@ touches one of them.
 
 import taichi as ti
 
+from wheelsoil.graph_launch import GraphKernel
+
 from .contact import hertz_mindlin
-from .neighbors import mat23, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
+from .neighbors import mat23, nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
 nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -209,9 +211,11 @@ def contact_forces(
     dt: ti.f64,
     force: nd_vec3,
     torque: nd_vec3,
-) -> ti.i32:
-    """Contact force [N] and torque [N m] on every particle; returns the number of contacts
-    (touching pairs plus particle--wall contacts). Two parallel loops, run one after the other:
+    result: nd_f64,
+):
+    """Contact force [N] and torque [N m] on every particle; writes the number of contacts (touching
+    pairs plus particle--wall contacts) to ``result[0]`` (it runs as a compute graph,
+    :data:`contact_forces_graph`, which cannot return values). Two parallel loops, run one after the other:
     over owners (:func:`owner_contacts`), then over partners (:func:`partner_contacts`).
     """
     n_contacts = 0
@@ -228,4 +232,8 @@ def contact_forces(
         f, t = partner_contacts(j, rev_start, partner_slot)
         force[j] += f
         torque[j] += t
-    return n_contacts
+    result[0] = n_contacts
+
+
+#: :func:`contact_forces` as a compute graph (same arguments; :mod:`wheelsoil.graph_launch`).
+contact_forces_graph = GraphKernel(contact_forces)

@@ -13,6 +13,8 @@ in three cache lines instead of six (:mod:`.forces`).
 
 import taichi as ti
 
+from wheelsoil.graph_launch import GraphKernel
+
 from .neighbors import nd_f64, nd_vec3, nd_vec4, vec3, vec4
 
 
@@ -90,9 +92,11 @@ def kick_drift(
     x_r: nd_vec4,
     v_m: nd_vec4,
     w_i: nd_vec4,
-) -> ti.f64:
-    """Half kick of v and omega, full drift of x, and the contact view of the new state; returns the
-    largest squared displacement since the last neighbour-list build [m^2]. Gravity (gx, gy, gz)
+    result: nd_f64,
+):
+    """Half kick of v and omega, full drift of x, and the contact view of the new state; writes the
+    largest squared displacement since the last neighbour-list build [m^2] to ``result[0]`` (it runs
+    as a compute graph, :data:`kick_drift_graph`, which cannot return values). Gravity (gx, gy, gz)
     [m/s^2] comes as three scalars: a vector argument costs Taichi ~40 us per launch on the Python
     side."""
     half = 0.5 * dt
@@ -103,7 +107,7 @@ def kick_drift(
         x[i] += dt * v[i]
         write_contact_view(i, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
         ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr())
-    return largest
+    result[0] = largest
 
 
 @ti.kernel
@@ -157,3 +161,8 @@ def state_health(
     out[1] = outside
     out[2] = vmax2
     out[3] = energy
+
+
+#: :func:`kick_drift` and :func:`kick` as compute graphs (same arguments; :mod:`wheelsoil.graph_launch`).
+kick_drift_graph = GraphKernel(kick_drift)
+kick_graph = GraphKernel(kick)

@@ -407,10 +407,11 @@ class Scene:
         largest = 0.0
         for k in range(n):
             if not drifted:
-                largest = integrator.kick_drift(
+                integrator.kick_drift_graph(
                     d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt, d["x_ref"],
-                    d["r"], d["x_r"], d["v_m"], d["w_i"],
+                    d["r"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
                 )
+                largest = float(d["step_result"][0])
             if largest > half_skin2:
                 self._rebuild_neighbors()
             if fused:
@@ -428,7 +429,7 @@ class Scene:
                 self._n_contacts = self._compute_forces(dt)
                 for body in self.interactions:
                     self._n_contacts += int(body.add_forces(self, dt))
-                integrator.kick(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt)
+                integrator.kick_graph(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt)
             self.time += dt
             self.steps_taken += 1
             if self.steps_taken % self.check_interval == 0:
@@ -453,14 +454,15 @@ class Scene:
     def _compute_forces(self, dt: float) -> int:
         d = self._dev
         pairs = d["pairs"]
-        return forces.contact_forces(
+        forces.contact_forces_graph(
             d["x_r"], d["v_m"], d["w_i"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["f"], d["t"],
+            d["f"], d["t"], d["step_result"],
         )
+        return int(d["step_result"][0])
 
     # ------------------------------------------------------------------ checkpoints
     _STATE_SCALARS = ("time", "steps_taken", "neighbor_rebuilds", "_n_contacts")

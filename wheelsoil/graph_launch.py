@@ -25,8 +25,8 @@ class GraphKernel:
     """Callable that runs ``kernel`` (a ``@ti.kernel`` with ndarray and scalar arguments and no return
     value) through a one-dispatch compute graph, compiled on first use in each Taichi program.
 
-    Call it with the kernel's arguments, positionally; scalars must be Python ``int`` (for integer
-    parameters) or ``float``.
+    Call it with the kernel's arguments, positionally; scalars are converted to ``float`` or ``int``
+    as their parameter's type asks.
     """
 
     def __init__(self, kernel):
@@ -36,6 +36,10 @@ class GraphKernel:
         self.kernel = kernel
         self.names = tuple(signature.parameters)
         self._annotations = [p.annotation for p in signature.parameters.values()]
+        # scalars go to the graph as the Python type of their parameter
+        self._scalar_types = [
+            None if isinstance(a, NdarrayType) else (float if a in (ti.f32, ti.f64) else int) for a in self._annotations
+        ]
 
     def _graph(self):
         key = (id(ti.lang.impl.get_runtime().prog), self.kernel)
@@ -57,4 +61,9 @@ class GraphKernel:
     def __call__(self, *args) -> None:
         if len(args) != len(self.names):
             raise TypeError(f"{self.kernel.__name__} takes {len(self.names)} arguments, got {len(args)}")
-        self._graph().run(dict(zip(self.names, args)))
+        self._graph().run(
+            {
+                name: value if kind is None else kind(value)
+                for name, value, kind in zip(self.names, args, self._scalar_types)
+            }
+        )
