@@ -47,7 +47,10 @@ class DeviceState:
     """The particle state arrays a scene steps (Taichi ndarrays, one row per sphere).
 
     For :class:`Interaction` objects that add forces from bodies the scene does not own; valid
-    until the next structural edit of the scene (adding or removing spheres or walls).
+    until the next structural edit of the scene (adding or removing spheres or walls). An
+    interaction reads the state and adds to ``force`` and ``torque``; it must not write ``x``, ``v``
+    or ``w``: the sphere--sphere force pass reads a copy of them made at each drift (the contact
+    view, :func:`wheelsoil.granular.integrator.write_contact_view`).
     """
 
     x: ti.Ndarray  # positions [m]
