@@ -19,6 +19,7 @@ Two kinds of work:
 import taichi as ti
 
 from wheelsoil.granular.contact import hertz_mindlin
+from wheelsoil.granular.neighbors import sort_run
 from wheelsoil.taichi_types import ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
 
 from .closest_point import EDGE_AB, EDGE_CA, FACE, VERTEX_A, closest_point_on_triangle
@@ -121,7 +122,7 @@ def fill_candidates(
     x: nd_vec3, radius: nd_f64, skin: ti.f64, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_start: nd_i32,
     cell_facets: nd_i32, xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, start: nd_i32, cand: nd_i32,
 ):
-    """Write each particle's candidate facets, sorted ascending (insertion sort: lists are short)."""
+    """Write each particle's candidate facets, sorted ascending (:func:`wheelsoil.granular.neighbors.sort_run`)."""
     for i in x:
         e0 = start[i]
         e1 = start[i + 1]
@@ -133,13 +134,7 @@ def fill_candidates(
                 if _within_reach(x[i], radius[i] + half_t[s] + skin, xw, tri, s):
                     cand[k] = s
                     k += 1
-            for a in range(e0 + 1, e1):
-                key = cand[a]
-                b = a - 1
-                while b >= e0 and cand[b] > key:
-                    cand[b + 1] = cand[b]
-                    b -= 1
-                cand[b + 1] = key
+            sort_run(cand, e0, e1)
 
 
 @ti.kernel

@@ -139,6 +139,19 @@ def near_walls(x: nd_vec3, radius: nd_f64, wall_point: nd_vec3, wall_normal: nd_
         wall_near[i] = mask
 
 
+@ti.func
+def sort_run(values: ti.template(), lo, hi):
+    """Sort ``values[lo:hi]`` (a 1-D integer array) ascending in place: an insertion sort, for the
+    short runs of a neighbour or candidate list (stable, no scratch memory, one thread per run)."""
+    for a in range(lo + 1, hi):
+        key = values[a]
+        b = a - 1
+        while b >= lo and values[b] > key:
+            values[b + 1] = values[b]
+            b -= 1
+        values[b + 1] = key
+
+
 # ---------------------------------------------------------------------------------------------
 # Pair list: every listed pair once (owner i < j), stored compactly, with its tangential history,
 # and the reverse index that lays the partner slots out by partner.
@@ -207,13 +220,6 @@ def fill_reverse_index(
     for j in cursor:
         lo = rev_start[j]
         hi = rev_start[j + 1]
-        # insertion sort of the (short) run
-        for a in range(lo + 1, hi):
-            key = rev_pair[a]
-            b = a - 1
-            while b >= lo and rev_pair[b] > key:
-                rev_pair[b + 1] = rev_pair[b]
-                b -= 1
-            rev_pair[b + 1] = key
+        sort_run(rev_pair, lo, hi)
         for e in range(lo, hi):
             pair_rev[rev_pair[e]] = e
