@@ -38,9 +38,9 @@ HUB_OWN_MASS, HUB_SAMPLES = 0, 1
 def node_update(
     n: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: ti.template(), v: ti.template(), rot: ti.template(),
     w: ti.template(), mass: ti.template(), inertia: ti.template(), free: ti.template(), f_ext: ti.template(),
-    k_ext: ti.template(), x_anchor: ti.template(), m_ext: ti.template(), slot_start: ti.template(), slot_list: ti.template(), slot_f: ti.template(),
-    slot_m: ti.template(), f_tot: ti.template(), m_tot: ti.template(), plane: ti.template(), plane_k: ti.f64,
-    contact: ti.template(), hub: ti.template(),
+    k_ext: ti.template(), x_anchor: ti.template(), m_ext: ti.template(), slot_start: ti.template(),
+    slot_list: ti.template(), slot_f: ti.template(), slot_m: ti.template(), f_tot: ti.template(),
+    m_tot: ti.template(), hub: ti.template(),
 ):
     """Gather node n's force and moment from its element slots; advance it if it is free.
 
@@ -52,17 +52,10 @@ def node_update(
     evaluated with the node at ``x_anchor`` together with their stiffness k_ext [N/m], so that within
     the sub-steps the force follows the node's own motion (otherwise a light node under stiff contacts
     would be driven unstably by forces held over the whole coupling interval).
-
-    A rigid frictionless plane (point ``plane[0]``, unit normal ``plane[1]``) pushes contact nodes
-    that penetrate it with the penalty force k_p * penetration along the normal (``plane_k`` = 0: off).
     """
     c1 = 1.0 - 0.5 * damping * dt
     c2 = 1.0 / (1.0 + 0.5 * damping * dt)
     f = f_ext[n] + mass[n] * gravity - k_ext[n] * (x[n] - x_anchor[n])
-    if plane_k > 0.0 and contact[n]:
-        depth = (plane[0] - x[n]).dot(plane[1])
-        if depth > 0.0:
-            f += plane_k * depth * plane[1]
     m = m_ext[n]
     for k in range(slot_start[n], slot_start[n + 1]):
         s = slot_list[k]
@@ -150,28 +143,6 @@ def kinetic_energy(n_nodes: ti.i32, v: nd_vec3, w: nd_vec3, mass: nd_f64, inerti
     for n in range(n_nodes):
         total += node_kinetic_energy(n, v, w, mass, inertia)
     return total
-
-
-@ti.kernel
-def kinetic_damping(n_nodes: ti.i32, v: nd_vec3, w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32, peak: nd_f64):
-    """Kinetic damping: zero the free nodes' velocities when the kinetic energy has passed a maximum.
-
-    ``peak[0]`` holds the kinetic energy after the previous step (0 after a reset).
-    """
-    total = 0.0
-    for n in range(n_nodes):
-        total += node_kinetic_energy(n, v, w, mass, inertia)
-    for _ in range(1):
-        peak[1] = 0.0
-        if total < peak[0]:
-            peak[1] = 1.0
-            peak[0] = 0.0
-        else:
-            peak[0] = total
-    for n in range(n_nodes):
-        if peak[1] > 0.5 and free[n]:
-            v[n] = vec3(0.0)
-            w[n] = vec3(0.0)
 
 
 @ti.kernel

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .beam import beam_frames, beam_section_stiffness
 from .mesh import StructureMesh
@@ -82,14 +81,3 @@ def assemble_stiffness(mesh: StructureMesh) -> sp.csr_matrix:
         vals.append(ke.ravel())
     n = 6 * mesh.n_nodes
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
-
-
-def solve_clamped(mesh: StructureMesh, clamped_nodes, loads: np.ndarray) -> np.ndarray:
-    """Linear displacements (N, 6) under nodal loads (N, 6) with ``clamped_nodes`` held fixed."""
-    k = assemble_stiffness(mesh)
-    fixed = np.zeros(6 * mesh.n_nodes, bool)
-    fixed[(6 * np.asarray(clamped_nodes)[:, None] + np.arange(6)).ravel()] = True
-    free = np.flatnonzero(~fixed)
-    u = np.zeros(6 * mesh.n_nodes)
-    u[free] = spla.spsolve(k[free][:, free].tocsc(), loads.reshape(-1)[free])
-    return u.reshape(-1, 6)

@@ -1,84 +1,126 @@
-"""The structure's time step as Taichi kernels, in a parallel and a serial form.
+"""The structure's time step as Taichi kernels, serial or parallel, each launched once for many steps.
 
 One central-difference step is: element forces into corner slots (facets, beams), node gather and
 update, hub update, hub nodes carried along, and (for static relaxation only) kinetic damping.
 
-* Parallel form: one kernel per phase, each a parallel loop. Right for large meshes.
-* Serial form: ``n_steps`` whole steps inside one kernel launch, every loop serial. On a CPU a
-  parallel loop costs tens of microseconds to dispatch, more than a small mesh's whole step, so
-  small structures (the verification problems, coarse wheels) run this way; the result is the same
-  to round-off.
+* Serial form (:data:`steps_serial`): ``n_steps`` whole steps inside one kernel launch, every loop serial.
+  On a CPU a parallel loop costs tens of microseconds to dispatch, more than a small mesh's whole step, so
+  small structures (the verification problems, the miniature wheel) run this way.
+* Parallel form (:func:`steps_parallel`): a kernel per number of steps n, compiled on first use, whose body
+  holds the n steps one after the other (unrolled at compile time), each a sequence of parallel loops --
+  one launch for the whole interval a coupling asks for, with every core on the elements and nodes.
+All are launched as compute graphs (:class:`wheelsoil.graph_launch.GraphKernel`): their 30-odd array
+arguments are set in C++, not in Taichi's Python launch path (~9 us each). The results are the same to
+round-off in every form (the serial and parallel loops sum every node's slots in the same order).
 """
 
 import taichi as ti
 
+from wheelsoil.graph_launch import GraphKernel
+from wheelsoil.taichi_types import nd_f64, nd_i32, nd_ivec2, nd_ivec3, nd_mat3, nd_mat9, nd_mat32, nd_vec3, nd_vec4, vec3
+
 from . import integrator as itg
 from .beam import beam_element
-from wheelsoil.taichi_types import nd_f64, nd_i32, nd_vec3, vec3
-
 from .shell import shell_element
 
+#: The arguments of every stepping kernel after its scalars, in order (the keys of ``Structure._dev``).
+ARRAYS = ("x", "v", "rot", "w", "mass", "inertia", "free", "f_ext", "k_ext", "x_anchor", "m_ext", "slot_start",
+          "slot_list", "slot_f", "slot_m", "f_tot", "m_tot", "tri", "frame0", "local0", "km", "kb", "ends", "bframe0",
+          "blen0", "rigidity", "hub_nodes", "hub_offset", "hub", "hub_rot", "hub_scalar", "peak")
 
-@ti.kernel
-def nodes_parallel(
-    n_nodes: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(),
-    w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32, f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32,
-    slot_list: nd_i32, slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3, plane: nd_vec3,
-    plane_k: ti.f64, contact: nd_i32, hub: nd_vec3,
-):
+
+@ti.func
+def _kinetic_restart(n_nodes, v: ti.template(), w: ti.template(), mass: ti.template(), inertia: ti.template(),
+                     free: ti.template(), peak: ti.template()):
+    """Kinetic damping: zero the free nodes' velocities once the kinetic energy has passed a maximum
+    (``peak[0]``: the kinetic energy after the previous step; 0 after a reset)."""
+    total = 0.0
     for n in range(n_nodes):
-        itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor, m_ext, slot_start,
-                        slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact, hub)
+        total += itg.node_kinetic_energy(n, v, w, mass, inertia)
+    if total < peak[0]:
+        peak[0] = 0.0
+        for n in range(n_nodes):
+            if free[n]:
+                v[n] = vec3(0.0)
+                w[n] = vec3(0.0)
+    else:
+        peak[0] = total
 
 
 @ti.kernel
-def hub_parallel(
-    n_hub: ti.i32, dt: ti.f64, gravity: vec3, hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3,
-    hub_rot: ti.types.ndarray(), hub_scalar: nd_f64, x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(), w: nd_vec3,
-    mass: nd_f64, inertia: nd_f64, f_tot: nd_vec3, m_tot: nd_vec3,
-):
-    for _ in range(1):
-        itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
-    for k in range(n_hub):
-        itg.hub_carry(k, hub_nodes, hub_offset, hub, hub_rot, x, v, rot, w)
-
-
-@ti.kernel
-def steps_serial(
-    n_steps: ti.i32, dt: ti.f64, damping: ti.f64, gravity: vec3, kinetic: ti.i32, counts: ti.types.vector(4, ti.i32),
-    x: nd_vec3, v: nd_vec3, rot: ti.types.ndarray(), w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
+def _steps_serial(
+    n_steps: ti.i32, dt: ti.f64, damping: ti.f64, gx: ti.f64, gy: ti.f64, gz: ti.f64, kinetic: ti.i32,
+    n_nodes: ti.i32, n_facets: ti.i32, n_beams: ti.i32, n_hub: ti.i32,
+    x: nd_vec3, v: nd_vec3, rot: nd_mat3, w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
     f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32,
-    slot_f: nd_vec3, slot_m: nd_vec3,
-    f_tot: nd_vec3, m_tot: nd_vec3,
-    tri: ti.types.ndarray(), frame0: ti.types.ndarray(), local0: ti.types.ndarray(), km: ti.types.ndarray(),
-    kb: ti.types.ndarray(),
-    ends: ti.types.ndarray(), bframe0: ti.types.ndarray(), blen0: nd_f64, rigidity: ti.types.ndarray(),
-    hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: ti.types.ndarray(), hub_scalar: nd_f64,
-    peak: nd_f64, plane: nd_vec3, plane_k: ti.f64, contact: nd_i32,
+    slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3,
+    tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9, kb: nd_mat9,
+    ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
+    hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
 ):
-    """``n_steps`` complete steps in one launch; counts = (nodes, facets, beams, hub nodes)."""
+    """``n_steps`` complete steps in one launch, every loop serial."""
+    gravity = vec3(gx, gy, gz)
     ti.loop_config(serialize=True)
     for _ in range(n_steps):
-        for e in range(counts[1]):
+        for e in range(n_facets):
             shell_element(e, x, rot, tri, frame0, local0, km, kb, slot_f, slot_m, 0, 1)
-        for e in range(counts[2]):
-            beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * counts[1], 1)
-        for n in range(counts[0]):
-            itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor, m_ext, slot_start,
-                            slot_list, slot_f, slot_m, f_tot, m_tot, plane, plane_k, contact, hub)
-        if counts[3] > 0:
-            itg.hub_update(dt, gravity, counts[3], hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
-            for k in range(counts[3]):
+        for e in range(n_beams):
+            beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets, 1)
+        for n in range(n_nodes):
+            itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
+                            m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
+        if n_hub > 0:
+            itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
+            for k in range(n_hub):
                 itg.hub_carry(k, hub_nodes, hub_offset, hub, hub_rot, x, v, rot, w)
         if kinetic:
-            total = 0.0
-            for n in range(counts[0]):
-                total += itg.node_kinetic_energy(n, v, w, mass, inertia)
-            if total < peak[0]:
-                peak[0] = 0.0
-                for n in range(counts[0]):
-                    if free[n]:
-                        v[n] = vec3(0.0)
-                        w[n] = vec3(0.0)
-            else:
-                peak[0] = total
+            _kinetic_restart(n_nodes, v, w, mass, inertia, free, peak)
+
+
+#: The serial stepping kernel as a compute graph: (n_steps, dt, damping, gx, gy, gz, kinetic, n_nodes,
+#: n_facets, n_beams, n_hub, *arrays in :data:`ARRAYS` order).
+steps_serial = GraphKernel(_steps_serial)
+
+_PARALLEL: dict = {}
+
+
+def steps_parallel(n_steps: int) -> GraphKernel:
+    """The parallel stepping kernel for exactly ``n_steps`` steps (compiled once per count), as a compute graph
+    taking (dt, damping, gx, gy, gz, kinetic, n_nodes, n_facets, n_beams, n_hub, *arrays in :data:`ARRAYS` order).
+    """
+    n_steps = int(n_steps)
+    if n_steps in _PARALLEL:
+        return _PARALLEL[n_steps]
+
+    @ti.kernel
+    def _steps(
+        dt: ti.f64, damping: ti.f64, gx: ti.f64, gy: ti.f64, gz: ti.f64, kinetic: ti.i32,
+        n_nodes: ti.i32, n_facets: ti.i32, n_beams: ti.i32, n_hub: ti.i32,
+        x: nd_vec3, v: nd_vec3, rot: nd_mat3, w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
+        f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32,
+        slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3,
+        tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9, kb: nd_mat9,
+        ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
+        hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
+    ):
+        gravity = vec3(gx, gy, gz)
+        for _step in ti.static(range(n_steps)):
+            for e in range(n_facets):
+                shell_element(e, x, rot, tri, frame0, local0, km, kb, slot_f, slot_m, 0, 1)
+            for e in range(n_beams):
+                beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets, 1)
+            for n in range(n_nodes):
+                itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
+                                m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
+            for _ in range(1):
+                if n_hub > 0:
+                    itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot,
+                                   m_tot)
+            for k in range(n_hub):
+                itg.hub_carry(k, hub_nodes, hub_offset, hub, hub_rot, x, v, rot, w)
+            for _ in range(1):
+                if kinetic:
+                    _kinetic_restart(n_nodes, v, w, mass, inertia, free, peak)
+
+    _PARALLEL[n_steps] = GraphKernel(_steps)
+    return _PARALLEL[n_steps]

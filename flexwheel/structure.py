@@ -67,6 +67,38 @@ def critical_frequency(mesh: StructureMesh) -> np.ndarray:
     return np.concatenate(out)
 
 
+def assembled_critical_frequency(mesh: StructureMesh) -> float:
+    """Largest circular frequency [rad/s] of the assembled, lumped-mass structure with every node free.
+
+    omega_max^2 is the largest eigenvalue of M^-1/2 K M^-1/2 (K of :func:`.linear.assemble_stiffness`, M the
+    lumped translational masses and rotary inertias), found by Lanczos iteration (``scipy.sparse.linalg.eigsh``;
+    a Ritz value approaches it from below, so it is raised by the solver's tolerance). Tying nodes to a hub or
+    holding them only removes freedom and cannot raise it (eigenvalue interlacing), so dt < 2 / omega_max is
+    the central-difference limit of the structure as stepped. It is below the largest element frequency
+    (:func:`critical_frequency`, Irons' bound) -- 28 % on the smoke wheel, where that bound set a step of
+    5.3e-5 s against 6.8e-5 s, and three wheel sub-steps per DEM step instead of two. Falls back to the element
+    bound if the iteration does not converge.
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from .linear import assemble_stiffness
+
+    bound = float(critical_frequency(mesh).max())
+    mass, inertia = mesh.lumped_mass()
+    diag = np.c_[mass, mass, mass, inertia, inertia, inertia].reshape(-1)
+    if np.any(diag <= 0.0):
+        return bound
+    scale = sp.diags(1.0 / np.sqrt(diag))
+    a = (scale @ assemble_stiffness(mesh) @ scale).tocsr()
+    tol = 1e-8
+    try:
+        lam = float(spla.eigsh(a, k=1, which="LA", return_eigenvectors=False, tol=tol, maxiter=20 * a.shape[0])[0])
+    except (spla.ArpackNoConvergence, spla.ArpackError):
+        return bound
+    return min(bound, math.sqrt(lam * (1.0 + 1e3 * tol)))
+
+
 class Structure:
     """A shell/beam structure advanced by explicit central differences on Taichi.
 
@@ -84,11 +116,18 @@ class Structure:
     safety: fraction of the critical step used by :meth:`advance` (0 < safety <= 1).
     arch: Taichi backend (see :func:`wheelsoil.runtime.init`).
     serial: run whole batches of steps in one serial kernel launch (default: for meshes of at most
-        ``SERIAL_ELEMENT_LIMIT`` elements, where parallel-loop dispatch costs more than the work).
+        ``SERIAL_ELEMENT_LIMIT`` elements, where parallel-loop dispatch costs more than the work); larger
+        meshes step with parallel loops, several steps per launch (:mod:`.stepper`).
     """
 
-    SERIAL_ELEMENT_LIMIT = 20_000
+    SERIAL_ELEMENT_LIMIT = 1_000
     MAX_STEPS_PER_LAUNCH = 20_000
+    #: Largest number of steps unrolled into one parallel launch (one kernel is compiled per count up to it).
+    #: Compile time grows faster than the unrolled body: on the 25,920-element lunar-rover mesh one step
+    #: compiles in ~5 s, two in ~5 s more, eight in ~20 min, while the step itself costs the same per step
+    #: (6.3 ms for one, 14.0 ms for two, 39.9 ms for eight; /tmp/ct.py, 2026-11-23). Two covers the coupled
+    #: smoke wheel's two sub-steps per soil step in one launch.
+    PARALLEL_STEPS_PER_LAUNCH = 2
 
     def __init__(
         self,
@@ -184,9 +223,6 @@ class Structure:
         d["f_tot"] = _vec(np.zeros((n, 3)))
         d["m_tot"] = _vec(np.zeros((n, 3)))
         d["peak"] = _nd(ti.f64, np.zeros(2))
-        d["plane"] = _vec(np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))
-        d["contact"] = _nd(ti.i32, np.zeros(n, np.int32))
-        self._plane_k = 0.0
         self._dev = d
 
         # ---- hub
@@ -216,7 +252,7 @@ class Structure:
         if rigid or n_slots == 0:
             self.critical_time_step = math.inf
         else:
-            omega = float(critical_frequency(mesh).max())
+            omega = assembled_critical_frequency(mesh)
             zeta = self.damping / (2.0 * omega)
             self.critical_time_step = 2.0 / omega * (math.sqrt(1.0 + zeta**2) - zeta)
         self.time = 0.0
@@ -258,35 +294,20 @@ class Structure:
         if n_steps <= 0:
             return
         d = self._dev
-        g = vec3(*self.gravity)
+        g = self.gravity
         n_facets = 0 if self.rigid else self.n_facets
         n_beams = 0 if self.rigid else self.n_beams
-        n_hub = len(self.hub_nodes)
+        counts = (self.mesh.n_nodes, n_facets, n_beams, len(self.hub_nodes))
+        arrays = [d[k] for k in stepper.ARRAYS]
         if self.serial:
-            counts = ti.Vector([self.mesh.n_nodes, n_facets, n_beams, n_hub], ti.i32)
             for done in range(0, n_steps, self.MAX_STEPS_PER_LAUNCH):
-                stepper.steps_serial(
-                    min(self.MAX_STEPS_PER_LAUNCH, n_steps - done), dt, self.damping, g, int(kinetic_damping), counts,
-                    d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"], d["free"], d["f_ext"], d["k_ext"], d["x_anchor"], d["m_ext"],
-                    d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"], d["f_tot"], d["m_tot"],
-                    d["tri"], d["frame0"], d["local0"], d["km"], d["kb"],
-                    d["ends"], d["bframe0"], d["blen0"], d["rigidity"],
-                    d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"], d["hub_scalar"], d["peak"],
-                    d["plane"], self._plane_k, d["contact"],
-                )
+                stepper.steps_serial(min(self.MAX_STEPS_PER_LAUNCH, n_steps - done), dt, self.damping, *g,
+                                     int(kinetic_damping), *counts, *arrays)
         else:
-            for _ in range(n_steps):
-                self._launch_element_forces()
-                stepper.nodes_parallel(
-                    self.mesh.n_nodes, dt, self.damping, g, d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
-                    d["free"], d["f_ext"], d["k_ext"], d["x_anchor"], d["m_ext"], d["slot_start"], d["slot_list"], d["slot_f"], d["slot_m"],
-                    d["f_tot"], d["m_tot"], d["plane"], self._plane_k, d["contact"], d["hub"])
-                if n_hub:
-                    stepper.hub_parallel(n_hub, dt, g, d["hub_nodes"], d["hub_offset"], d["hub"], d["hub_rot"],
-                                         d["hub_scalar"], d["x"], d["v"], d["rot"], d["w"], d["mass"], d["inertia"],
-                                         d["f_tot"], d["m_tot"])
-                if kinetic_damping:
-                    itg.kinetic_damping(self.mesh.n_nodes, d["v"], d["w"], d["mass"], d["inertia"], d["free"], d["peak"])
+            chunk = self.PARALLEL_STEPS_PER_LAUNCH
+            for done in range(0, n_steps, chunk):
+                stepper.steps_parallel(min(chunk, n_steps - done))(dt, self.damping, *g, int(kinetic_damping),
+                                                                    *counts, *arrays)
         self.time += dt * n_steps
         self.steps_taken += n_steps
 
@@ -310,12 +331,12 @@ class Structure:
 
     #: Device arrays that change while the structure moves (the rest is set up once from the mesh).
     DYNAMIC_ARRAYS = ("x", "v", "rot", "w", "f_ext", "k_ext", "x_anchor", "m_ext", "f_tot", "m_tot", "slot_f",
-                      "slot_m", "peak", "plane", "contact", "hub", "hub_rot", "hub_scalar")
+                      "slot_m", "peak", "hub", "hub_rot", "hub_scalar")
 
     def state(self) -> dict:
         """Node and hub state, held loads and the clock as NumPy arrays and scalars (for checkpoints)."""
         out = {k: self._dev[k].to_numpy() for k in self.DYNAMIC_ARRAYS}
-        out.update(time=self.time, steps_taken=self.steps_taken, plane_stiffness=self._plane_k)
+        out.update(time=self.time, steps_taken=self.steps_taken)
         return out
 
     def restore_state(self, state: dict) -> None:
@@ -326,7 +347,6 @@ class Structure:
                 raise WheelsoilInputError(f"the saved wheel state {k!r} has shape {value.shape}; it belongs to another mesh")
             self._dev[k].from_numpy(np.ascontiguousarray(value))
         self.time, self.steps_taken = float(state["time"]), int(state["steps_taken"])
-        self._plane_k = float(state["plane_stiffness"])
 
     def check_health(self) -> None:
         """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
@@ -338,30 +358,6 @@ class Structure:
                 f"{math.sqrt(worst) if worst < 1e300 else float('nan'):.3g} m/s (limit {limit:.3g} m/s, NaN means "
                 "non-finite state). Reduce the time step (safety) or the loads."
             )
-
-    # ------------------------------------------------------------------ rigid plane
-    def set_plane(self, point, normal, stiffness: float, nodes=None) -> None:
-        """A rigid frictionless plane that pushes ``nodes`` (default: the surface facets' nodes) back
-        with the penalty force ``stiffness`` [N/m] x penetration along ``normal``. ``stiffness=0`` removes it.
-        """
-        normal = np.asarray(normal, float).reshape(3)
-        if not (np.isfinite(stiffness) and stiffness >= 0) or np.linalg.norm(normal) == 0:
-            raise WheelsoilInputError(f"plane stiffness={stiffness!r} must be >= 0 and the normal non-zero")
-        nodes = np.unique(self.surface_triangles) if nodes is None else np.asarray(nodes, np.int64)
-        mask = np.zeros(self.mesh.n_nodes, np.int32)
-        mask[nodes] = 1
-        self._dev["contact"].from_numpy(mask)
-        self._dev["plane"].from_numpy(np.array([np.asarray(point, float).reshape(3), normal / np.linalg.norm(normal)]))
-        self._plane_k = float(stiffness)
-
-    def plane_force(self) -> np.ndarray:
-        """Force [N] the rigid plane exerts on the structure in the current state."""
-        if self._plane_k == 0.0:
-            return np.zeros(3)
-        point, normal = self._dev["plane"].to_numpy()
-        mask = self._dev["contact"].to_numpy().astype(bool)
-        depth = np.clip((point - self.positions()[mask]) @ normal, 0.0, None)
-        return self._plane_k * depth.sum() * normal
 
     # ------------------------------------------------------------------ hub
     def _hub_state(self) -> np.ndarray:
@@ -391,6 +387,20 @@ class Structure:
             if val is not None:
                 s[row] = np.asarray(val, bool).reshape(3).astype(float)
         self._dev["hub"].from_numpy(s)
+
+    def translate(self, offset) -> None:
+        """Move the whole structure rigidly by ``offset`` [m] (nodes, the anchors of held contact forces and the
+        hub; velocities, rotations and forces unchanged): a moving soil patch re-centring the wheel."""
+        off = np.asarray(offset, float).reshape(3)
+        if not np.all(np.isfinite(off)):
+            raise WheelsoilInputError(f"translation {off.tolist()} must be finite")
+        for key in ("x", "x_anchor"):
+            self._dev[key].from_numpy(self._dev[key].to_numpy() + off)
+        if self.hub_nodes.size:
+            s = self._hub_state()
+            s[itg.HUB_POSITION] += off
+            self._dev["hub"].from_numpy(s)
+        self.hub_center0 = self.hub_center0 + off
 
     def set_hub_state(self, *, velocity=None, angular_velocity=None) -> None:
         """Set the hub's current velocity and spin (e.g. to start a free dof moving)."""
