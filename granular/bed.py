@@ -37,7 +37,9 @@ from .scene import Scene
 
 #: Bump when the preparation protocol changes so that stale caches are not reused.
 #: 2: spheres in column order (:mod:`.ordering`) from the lattice on.
-BED_FORMAT_VERSION = 2
+#: 3: the settled bed keeps its tangential contact history (pairs and walls), so a scene made from it starts
+#:    in the prepared equilibrium instead of re-seating (friction-held spheres slipping until it rebuilds).
+BED_FORMAT_VERSION = 3
 
 
 class BedNotSettledError(SimulationUnstableError):
@@ -61,7 +63,9 @@ class BedSpec:
         ``None``: 0.5 m_mean (5 mm/s)^2.
     max_settle_time: give up (error) after this much simulated time per settling phase [s].
     overfill: particles for ``overfill`` x the target depth, so levelling has some to remove.
-    time_step: DEM time step [s]; ``None`` uses the stable estimate.
+    time_step: DEM time step [s] of the preparation; ``None`` uses the stable estimate.
+    periodic: the bin is periodic along x (no end walls; :class:`~.scene.Scene` ``periodic_x``): a soil
+        patch that a moving-patch testbed can shift without end (``wheelsoil.coupling.patch``).
     """
 
     length: float = 0.5
@@ -79,6 +83,7 @@ class BedSpec:
     max_settle_time: float = 10.0
     overfill: float = 1.15
     time_step: float | None = None
+    periodic: bool = False
 
     def __post_init__(self) -> None:
         for name in ("length", "width", "depth", "diameter_min", "diameter_max", "max_settle_time"):
@@ -113,6 +118,7 @@ class BedSpec:
             )
         if self.time_step is not None and not (self.time_step > 0):
             raise WheelsoilInputError(f"bed time_step = {self.time_step!r} s must be > 0")
+        object.__setattr__(self, "periodic", bool(self.periodic))
 
     # ---------------------------------------------------------------- derived quantities
     @property
@@ -136,6 +142,8 @@ class BedSpec:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["gravity"] = list(self.gravity)
+        if not self.periodic:  # beds prepared before periodic bins existed keep their cache keys
+            d.pop("periodic")
         return d
 
     @classmethod
@@ -167,6 +175,9 @@ class Bed:
     packing_fraction: float
     settle_time: float
     meta: dict = field(default_factory=dict)
+    #: Tangential contact history of the settled bed (``Scene.contact_history`` arrays plus ``wall_point`` and
+    #: ``wall_normal`` of the walls its ``xi_wall`` columns belong to); None for beds of format 2.
+    history: dict | None = None
 
     @property
     def n_particles(self) -> int:
@@ -176,7 +187,7 @@ class Bed:
         s = self.spec
         g = s.gravity_magnitude
         return (
-            f"bed {s.length:g} x {s.width:g} m, {self.n_particles} particles of {1e3 * s.diameter_min:g}-"
+            f"{'periodic ' if s.periodic else ''}bed {s.length:g} x {s.width:g} m, {self.n_particles} particles of {1e3 * s.diameter_min:g}-"
             f"{1e3 * s.diameter_max:g} mm at g = {g:.3g} m/s^2: surface {self.surface_height:.4f} m "
             f"(target {s.depth:g} m), packing fraction {self.packing_fraction:.3f}, "
             f"settled in {self.settle_time:.2f} s simulated"
@@ -192,6 +203,10 @@ class Bed:
             grp.create_dataset("velocity", data=self.velocities).attrs["units"] = "m/s"
             grp.create_dataset("angular_velocity", data=self.angular_velocities).attrs["units"] = "rad/s"
             grp.create_dataset("radius", data=self.radii).attrs["units"] = "m"
+            if self.history is not None:
+                hist = f.create_group("contacts")
+                for key, value in self.history.items():
+                    hist.create_dataset(key, data=value)
             f.attrs["kind"] = "wheelsoil soil bed"
             f.attrs["bed_format"] = BED_FORMAT_VERSION
             f.attrs["spec"] = json.dumps(self.spec.to_dict(), sort_keys=True)
@@ -215,6 +230,7 @@ class Bed:
                 raise WheelsoilInputError(f"{str(path)!r} is not a wheelsoil soil-bed file")
             p = f["particles"]
             meta = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+            history = {k: f["contacts"][k][()] for k in f["contacts"]} if "contacts" in f else None
             return cls(
                 spec=BedSpec.from_dict(json.loads(f.attrs["spec"])),
                 positions=p["position"][...],
@@ -225,25 +241,59 @@ class Bed:
                 packing_fraction=float(f.attrs["packing_fraction"]),
                 settle_time=float(f.attrs["settle_time"]),
                 meta={k: meta[k] for k in ("version", "git_rev", "taichi_version", "arch", "created") if k in meta},
+                history=history,
             )
 
-    def to_scene(self, *, headroom: float | None = None, arch: str | None = None, **scene_kwargs) -> Scene:
-        """A :class:`Scene` holding this bed in its bin (floor and four side walls).
+    def to_scene(self, *, headroom: float | None = None, arch: str | None = None, periodic_x: bool | None = None,
+                 end_walls: bool = True, **scene_kwargs) -> Scene:
+        """A :class:`Scene` holding this bed in its bin (floor and four side walls; a periodic bed: floor and
+        side walls, periodic along x).
 
         ``headroom`` [m] extends the domain above the surface (default: the bed depth, at least
-        0.1 m). Contact history starts afresh; the bed is at rest, so it re-seats within a few steps.
+        0.1 m). ``periodic_x=False`` puts a periodic bed in a bin that is not periodic; ``end_walls=False``
+        leaves out the walls at its two ends (a moving soil patch holds the spheres there instead,
+        ``wheelsoil.coupling.patch``).
+        The scene starts with the bed's contact history (a bed of format 3): pairs and the walls the two bins
+        share (floor and side walls; a pair across a periodic end that the end walls separate is dropped).
         """
         s = self.spec
         top = self.surface_height + (headroom if headroom is not None else max(s.depth, 0.1))
+        periodic = s.periodic if periodic_x is None else bool(periodic_x) and s.periodic
         scene = Scene(
             (0.0, 0.0, 0.0), (s.length, s.width, top),
-            gravity=s.gravity, material=s.material, pair=s.pair, arch=arch, **scene_kwargs,
+            gravity=s.gravity, material=s.material, pair=s.pair, arch=arch, periodic_x=periodic, **scene_kwargs,
         )
-        scene.add_box_walls(material=s.wall_material, pair=s.wall_pair)
-        scene.add_spheres(self.positions, self.radii, self.velocities, self.angular_velocities)
+        if end_walls or periodic:
+            scene.add_box_walls(material=s.wall_material, pair=s.wall_pair)
+        else:
+            lo, hi = scene.domain_min, scene.domain_max
+            for point, normal in ((lo, (0, 0, 1)), (lo, (0, 1, 0)), (hi, (0, -1, 0))):
+                scene.add_wall(point, normal, material=s.wall_material, pair=s.wall_pair)
+        x = self.positions
+        if s.periodic:  # the stored centres may lie a hair outside the period
+            x = x.copy()
+            x[:, 0] = np.mod(x[:, 0], s.length)
+        scene.add_spheres(x, self.radii, self.velocities, self.angular_velocities,
+                          wall_history=self._wall_history(scene))
+        if self.history is not None and len(self.history["pair_i"]):
+            scene.set_contact_history(self.history["pair_i"], self.history["pair_j"], self.history["pair_xi"])
         if s.time_step is not None:
             scene.time_step = s.time_step
         return scene
+
+
+    def _wall_history(self, scene: Scene) -> np.ndarray | None:
+        """The bed's wall history in the columns of ``scene``'s walls (matched by point and normal; zero for a
+        wall the bed had not)."""
+        h = self.history
+        if h is None or "xi_wall" not in h:
+            return None
+        out = np.zeros((self.n_particles, len(scene.walls), 3))
+        for k, wall in enumerate(scene.walls):
+            for b, (point, normal) in enumerate(zip(h["wall_point"], h["wall_normal"])):
+                if np.allclose(normal, wall.normal) and abs(np.dot(np.asarray(wall.point) - point, normal)) < 1e-12:
+                    out[:, k] = h["xi_wall"][:, b]
+        return out
 
 
 # ---------------------------------------------------------------------- preparation
@@ -254,13 +304,17 @@ def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
     spacing = spec.diameter_max * 1.05
     nx = int((spec.length - 2 * r_max) // spacing) + 1
     ny = int((spec.width - 2 * r_max) // spacing) + 1
+    spacing_x = spacing
+    if spec.periodic:  # the lattice tiles the period exactly: no seam where the ends meet
+        nx = int(spec.length // spacing)
+        spacing_x = spec.length / nx
     needed = spec.overfill * 0.6 * spec.length * spec.width * spec.depth / spec.mean_particle_volume
     layers = max(2, int(math.ceil(needed / (nx * ny))))
     ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(layers), indexing="ij")
     # centre the lattice in the bin
-    x0 = 0.5 * (spec.length - (nx - 1) * spacing)
+    x0 = 0.5 * (spec.length - (nx - 1) * spacing_x)
     y0 = 0.5 * (spec.width - (ny - 1) * spacing)
-    pos = np.stack([x0 + ix * spacing, y0 + iy * spacing, r_max * 1.05 + iz * spacing], -1).reshape(-1, 3)
+    pos = np.stack([x0 + ix * spacing_x, y0 + iy * spacing, r_max * 1.05 + iz * spacing], -1).reshape(-1, 3)
     # column by column (memory locality for the force pass; see .ordering)
     pos = pos[column_order(pos, spacing)]
     diam = rng.uniform(spec.diameter_min, spec.diameter_max, len(pos))
@@ -272,9 +326,10 @@ def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
 def measure_surface(positions: np.ndarray, radii: np.ndarray, spec: BedSpec) -> float:
     """Mean over d_max-wide columns (away from the walls) of the highest sphere top [m]."""
     d = spec.diameter_max
-    nx = max(1, int((spec.length - 2 * d) // d))
+    margin_x = 0.0 if spec.periodic else d  # a periodic bin has no end walls
+    nx = max(1, int((spec.length - 2 * margin_x) // d))
     ny = max(1, int((spec.width - 2 * d) // d))
-    ix = np.floor((positions[:, 0] - d) / d).astype(int)
+    ix = np.floor((positions[:, 0] - margin_x) / d).astype(int)
     iy = np.floor((positions[:, 1] - d) / d).astype(int)
     inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
     tops = np.full(nx * ny, -np.inf)
@@ -292,8 +347,9 @@ def measure_packing_fraction(positions: np.ndarray, radii: np.ndarray, spec: Bed
     when the region is only a diameter or so tall, as in small test beds.
     """
     d = spec.diameter_max
-    lo = np.array([d, d, d])
-    hi = np.array([spec.length - d, spec.width - d, surface - d])
+    margin_x = 0.0 if spec.periodic else d  # a periodic bin has no end walls
+    lo = np.array([margin_x, d, d])
+    hi = np.array([spec.length - margin_x, spec.width - d, surface - d])
     if np.any(hi <= lo):
         lo, hi = np.zeros(3), np.array([spec.length, spec.width, surface])
     inside = np.all((positions[:, :2] >= lo[:2]) & (positions[:, :2] <= hi[:2]), axis=1)
@@ -370,7 +426,7 @@ def prepare_bed(
         (0.0, 0.0, 0.0),
         (spec.length, spec.width, max(fill_top, spec.depth) + spec.diameter_max * 2),
         gravity=spec.gravity, material=spec.material, pair=spec.pair, arch=arch,
-        impact_speed=max(1.0, math.sqrt(2 * spec.gravity_magnitude * fill_top)),
+        impact_speed=max(1.0, math.sqrt(2 * spec.gravity_magnitude * fill_top)), periodic_x=spec.periodic,
     )
     scene.add_box_walls(material=spec.wall_material, pair=spec.wall_pair)
     scene.add_spheres(positions, radii)
@@ -402,7 +458,20 @@ def prepare_bed(
     # exactly into the columns of the settled positions.
     order = column_order(scene.positions, spec.diameter_max)
     x, r = scene.positions[order], scene.radii[order]
+    if spec.periodic:
+        x[:, 0] = np.mod(x[:, 0], spec.length)
     surface = measure_surface(x, r, spec)
+    # the contact history, renumbered to the column order
+    hist = scene.contact_history()
+    new_index = np.empty(len(order), np.int64)
+    new_index[order] = np.arange(len(order))
+    pi, pj = new_index[hist["pair_i"]], new_index[hist["pair_j"]]
+    touching = np.any(hist["pair_xi"] != 0.0, axis=1)
+    pi, pj, pxi = np.minimum(pi, pj)[touching], np.maximum(pi, pj)[touching], hist["pair_xi"][touching]
+    srt = np.lexsort((pj, pi))
+    history = {"pair_i": pi[srt].astype(np.int32), "pair_j": pj[srt].astype(np.int32), "pair_xi": pxi[srt],
+               "xi_wall": hist["xi_wall"][order],
+               "wall_point": np.array([w.point for w in scene.walls]), "wall_normal": np.array([w.normal for w in scene.walls])}
     bed = Bed(
         spec=spec,
         positions=x,
@@ -413,6 +482,7 @@ def prepare_bed(
         packing_fraction=measure_packing_fraction(x, r, spec, surface),
         settle_time=t_settle + t_level,
         meta={"prepare_seconds": time.perf_counter() - wall_clock, "time_step": scene.time_step},
+        history=history,
     )
     if use_cache:
         bed.save(path)

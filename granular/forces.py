@@ -34,7 +34,7 @@ import taichi as ti
 from wheelsoil.graph_launch import GraphKernel
 
 from .contact import hertz_mindlin
-from .neighbors import mat23, nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
+from .neighbors import mat23, nd_f64, nearest_image, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
 nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -66,6 +66,8 @@ def owner_contacts(
     mu_s,
     mu_r,
     dt,
+    period,
+    inv_period,
 ):
     """Force [N] and torque [N m] on particle ``i`` from the pairs it owns and from the walls, and its
     number of contacts; writes each owned pair's partner slot (force on j [N], torque on j [N m]).
@@ -76,7 +78,8 @@ def owner_contacts(
     mask of the walls particle i touched at the last step, so a wall history is cleared once on
     separation rather than every step; ``wall_near[i]`` the mask of the walls within reach since
     the last rebuild (:func:`.neighbors.near_walls`). Only walls in either mask are checked: most
-    particles of a bed are far from every wall and skip the loop.
+    particles of a bed are far from every wall and skip the loop. ``period``, ``inv_period``: the
+    periodic length along x and its inverse (0 and 0 without periodicity; :func:`.neighbors.nearest_image`).
     """
     own_x = x_r[i]
     own_v = v_m[i]
@@ -93,7 +96,7 @@ def owner_contacts(
     for p in range(pair_start[i], pair_start[i + 1]):
         j = pair_j[p]
         other_x = x_r[j]
-        d = other_x.xyz - xi_pos
+        d = nearest_image(other_x.xyz - xi_pos, period, inv_period)
         rj = other_x[3]
         reach = ri + rj
         dist2 = d.norm_sqr()
@@ -185,6 +188,16 @@ def partner_contacts(j, rev_start: ti.template(), partner_slot: ti.template()):
     return f, t
 
 
+@ti.func
+def add_external(j, force: ti.template(), torque: ti.template(), ext_force: ti.template(), ext_torque: ti.template()):
+    """force[j] += ext_force[j], torque[j] += ext_torque[j], and clear the external arrays (interactions add
+    into them afresh every step)."""
+    force[j] += ext_force[j]
+    torque[j] += ext_torque[j]
+    ext_force[j] = vec3(0.0, 0.0, 0.0)
+    ext_torque[j] = vec3(0.0, 0.0, 0.0)
+
+
 @ti.kernel
 def contact_forces(
     x_r: nd_vec4,
@@ -209,12 +222,19 @@ def contact_forces(
     mu_s: ti.f64,
     mu_r: ti.f64,
     dt: ti.f64,
+    period: ti.f64,
+    inv_period: ti.f64,
+    external: ti.i32,
+    ext_force: nd_vec3,
+    ext_torque: nd_vec3,
     force: nd_vec3,
     torque: nd_vec3,
     result: nd_f64,
 ):
-    """Contact force [N] and torque [N m] on every particle; writes the number of contacts (touching
-    pairs plus particle--wall contacts) to ``result[0]`` (it runs as a compute graph,
+    """Contact force [N] and torque [N m] on every particle; with ``external`` != 0 it adds the external
+    contact forces and torques that interactions (a wheel) put into ``ext_force``/``ext_torque`` and clears
+    them for the next step. Writes the number of contacts (touching pairs plus particle--wall contacts) to
+    ``result[0]`` (it runs as a compute graph,
     :data:`contact_forces_graph`, which cannot return values). Two parallel loops, run one after the other:
     over owners (:func:`owner_contacts`), then over partners (:func:`partner_contacts`).
     """
@@ -223,7 +243,7 @@ def contact_forces(
         f, t, n = owner_contacts(
             i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
             partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
-            e_eff, g_eff, beta, mu_s, mu_r, dt,
+            e_eff, g_eff, beta, mu_s, mu_r, dt, period, inv_period,
         )
         force[i] = f
         torque[i] = t
@@ -232,6 +252,8 @@ def contact_forces(
         f, t = partner_contacts(j, rev_start, partner_slot)
         force[j] += f
         torque[j] += t
+        if external != 0:
+            add_external(j, force, torque, ext_force, ext_torque)
     result[0] = n_contacts
 
 

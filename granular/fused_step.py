@@ -1,9 +1,10 @@
-"""One kernel launch per DEM step for scenes without extra interactions.
+"""One kernel launch per DEM step, with or without interactions (a wheel).
 
 A velocity-Verlet step (:mod:`.integrator`) is kick--drift, forces, kick. Between two steps nothing
-reads the state when the scene has no interaction (wheel) and no callback or health check is due, so
-the second half kick of step n and the first half kick and drift of step n+1 can run in the same
-particle loop as the partner gather of step n. :func:`contact_step` does that: the owner loop and
+reads the state when no callback or health check is due, so the second half kick of step n and the first
+half kick and drift of step n+1 can run in the same particle loop as the partner gather of step n.
+Interactions evaluate their contacts at the drifted positions *before* this launch and leave their forces
+in the external arrays, which the partner loop adds (and clears). :func:`contact_step` does that: the owner loop and
 the partner loop of :func:`.forces.contact_forces`, then, per particle,
 
     v += dt/2 (F/m + g), omega += dt/2 T/I                 (second half kick of this step)
@@ -22,7 +23,7 @@ import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
 
-from .forces import nd_f64_2d, owner_contacts, partner_contacts
+from .forces import add_external, nd_f64_2d, owner_contacts, partner_contacts
 from .integrator import half_kick, write_contact_view
 from .neighbors import nd_f64, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
@@ -35,6 +36,7 @@ def contact_step(
     radius: nd_f64,
     mass: nd_f64,
     inertia: nd_f64,
+    mobile: nd_f64,
     pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
@@ -54,6 +56,11 @@ def contact_step(
     mu_s: ti.f64,
     mu_r: ti.f64,
     dt: ti.f64,
+    period: ti.f64,
+    inv_period: ti.f64,
+    external: ti.i32,
+    ext_force: nd_vec3,
+    ext_torque: nd_vec3,
     force: nd_vec3,
     torque: nd_vec3,
     gx: ti.f64,
@@ -77,7 +84,7 @@ def contact_step(
         f, t, n = owner_contacts(
             i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
             partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
-            e_eff, g_eff, beta, mu_s, mu_r, dt,
+            e_eff, g_eff, beta, mu_s, mu_r, dt, period, inv_period,
         )
         force[i] = f
         torque[i] = t
@@ -89,9 +96,11 @@ def contact_step(
         f, t = partner_contacts(j, rev_start, partner_slot)
         force[j] += f
         torque[j] += t
-        half_kick(j, v, omega, force, torque, mass, inertia, gravity, half)
+        if external != 0:
+            add_external(j, force, torque, ext_force, ext_torque)
+        half_kick(j, v, omega, force, torque, mass, inertia, mobile, gravity, half)
         if drift != 0:
-            half_kick(j, v, omega, force, torque, mass, inertia, gravity, half)
+            half_kick(j, v, omega, force, torque, mass, inertia, mobile, gravity, half)
             x[j] += dt * v[j]
             write_contact_view(j, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
             ti.atomic_max(largest, (x[j] - x_ref[j]).norm_sqr())

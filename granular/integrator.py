@@ -66,12 +66,14 @@ def half_kick(
     torque: ti.template(),
     mass: ti.template(),
     inertia: ti.template(),
+    mobile: ti.template(),
     gravity,
     half,
 ):
-    """v += dt/2 (F/m + g), omega += dt/2 T/I for particle i."""
-    v[i] += half * (force[i] / mass[i] + gravity)
-    omega[i] += half * (torque[i] / inertia[i])
+    """v += dt/2 (F/m + g), omega += dt/2 T/I for particle i; both times ``mobile[i]`` (1, or 0 for a sphere
+    held where it is: it keeps zero velocity and spin, so it never moves, and acts on the others as a wall)."""
+    v[i] = mobile[i] * (v[i] + half * (force[i] / mass[i] + gravity))
+    omega[i] = mobile[i] * (omega[i] + half * (torque[i] / inertia[i]))
 
 
 @ti.kernel
@@ -83,6 +85,7 @@ def kick_drift(
     torque: nd_vec3,
     mass: nd_f64,
     inertia: nd_f64,
+    mobile: nd_f64,
     gx: ti.f64,
     gy: ti.f64,
     gz: ti.f64,
@@ -103,7 +106,7 @@ def kick_drift(
     gravity = vec3(gx, gy, gz)
     largest = 0.0
     for i in x:
-        half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
+        half_kick(i, v, omega, force, torque, mass, inertia, mobile, gravity, half)
         x[i] += dt * v[i]
         write_contact_view(i, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
         ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr())
@@ -118,6 +121,7 @@ def kick(
     torque: nd_vec3,
     mass: nd_f64,
     inertia: nd_f64,
+    mobile: nd_f64,
     gx: ti.f64,
     gy: ti.f64,
     gz: ti.f64,
@@ -127,7 +131,7 @@ def kick(
     half = 0.5 * dt
     gravity = vec3(gx, gy, gz)
     for i in v:
-        half_kick(i, v, omega, force, torque, mass, inertia, gravity, half)
+        half_kick(i, v, omega, force, torque, mass, inertia, mobile, gravity, half)
 
 
 @ti.kernel

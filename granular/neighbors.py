@@ -32,6 +32,27 @@ from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, i
 
 
 @ti.func
+def nearest_image(d: vec3, period: ti.f64, inv_period: ti.f64) -> vec3:
+    """The separation d [m] taken to the nearest periodic image along x (minimum-image convention,
+    Allen & Tildesley, *Computer Simulation of Liquids*, sec. 1.5.2): d_x - L round(d_x / L). With
+    period = inv_period = 0 (no periodicity) it returns d unchanged, to the bit."""
+    return vec3(d[0] - period * ti.round(d[0] * inv_period), d[1], d[2])
+
+
+@ti.kernel
+def wrap_positions(x: nd_vec3, x_r: nd_vec4, origin_x: ti.f64, period: ti.f64):
+    """Bring every centre back into [origin_x, origin_x + period) along x (periodic domain), in the
+    positions and in the contact view."""
+    for i in x:
+        u = x[i][0] - origin_x
+        u -= period * ti.floor(u / period)
+        if u >= period:  # round-off of a centre a hair below the origin
+            u -= period
+        x[i][0] = origin_x + u
+        x_r[i][0] = origin_x + u
+
+
+@ti.func
 def cell_coords(p: vec3, origin: vec3, inv_cell: ti.f64, dims: ivec3) -> ivec3:
     c = ti.cast(ti.floor((p - origin) * inv_cell), ti.i32)
     return ti.max(ti.min(c, dims - 1), 0)
@@ -82,11 +103,16 @@ def build_neighbor_lists(
     inv_cell: ti.f64,
     dims: ivec3,
     skin: ti.f64,
+    period: ti.f64,
+    inv_period: ti.f64,
     nbr: nd_i32_2d,
     nbr_count: nd_i32,
 ) -> ti.i32:
     """Fill each particle's row with the partners j > i closer than r_i + r_j + skin, sorted by j.
 
+    ``period`` > 0 makes the domain periodic along x with that length (``inv_period`` = 1 / period;
+    both 0 otherwise): the cells wrap around in x (the grid must have at least 3 cells along x and a
+    cell edge of period / cells) and distances are taken to the nearest image (:func:`nearest_image`).
     Returns the largest number of partners found for one particle; when it exceeds the row width
     the rows are truncated and the caller must widen them and call again.
     """
@@ -99,13 +125,15 @@ def build_neighbor_lists(
         count = 0
         for dz, dy, dx in ti.ndrange((-1, 2), (-1, 2), (-1, 2)):
             cc = c + ivec3(dx, dy, dz)
+            if period > 0.0:
+                cc[0] = (cc[0] + dims[0]) % dims[0]
             if (cc >= 0).all() and (cc < dims).all():
                 cid = (cc[2] * dims[1] + cc[1]) * dims[0] + cc[0]
                 for s in range(cell_start[cid], cell_start[cid + 1]):
                     j = sorted_ids[s]
                     if j > i:
                         reach = ri + radius[j] + skin
-                        if (x[j] - xi).norm_sqr() < reach * reach:
+                        if nearest_image(x[j] - xi, period, inv_period).norm_sqr() < reach * reach:
                             if count < width:
                                 nbr[i, count] = j
                             count += 1

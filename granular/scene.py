@@ -48,9 +48,10 @@ class DeviceState:
 
     For :class:`Interaction` objects that add forces from bodies the scene does not own; valid
     until the next structural edit of the scene (adding or removing spheres or walls). An
-    interaction reads the state and adds to ``force`` and ``torque``; it must not write ``x``, ``v``
-    or ``w``: the sphere--sphere force pass reads a copy of them made at each drift (the contact
-    view, :func:`wheelsoil.granular.integrator.write_contact_view`).
+    interaction reads the state and adds its contact forces and torques to ``external_force`` and
+    ``external_torque`` (the step adds them to the contact forces and clears them); it must not write
+    ``x``, ``v`` or ``w``: the sphere--sphere force pass reads a copy of them made at each drift (the
+    contact view, :func:`wheelsoil.granular.integrator.write_contact_view`).
     """
 
     x: ti.Ndarray  # positions [m]
@@ -59,8 +60,10 @@ class DeviceState:
     radius: ti.Ndarray  # [m]
     mass: ti.Ndarray  # [kg]
     inertia: ti.Ndarray  # moments of inertia [kg m^2]
-    force: ti.Ndarray  # contact force of this step [N]; an interaction adds to it
-    torque: ti.Ndarray  # contact torque of this step [N m]; an interaction adds to it
+    force: ti.Ndarray  # contact force of the last step [N]
+    torque: ti.Ndarray  # contact torque of the last step [N m]
+    external_force: ti.Ndarray  # an interaction adds its contact forces here [N]
+    external_torque: ti.Ndarray  # an interaction adds its contact torques here [N m]
 
 
 class Interaction:
@@ -70,9 +73,10 @@ class Interaction:
 
     * ``after_drift(scene, dt)`` once the spheres have drifted to t + dt (a body advances itself
       to t + dt here), then
-    * ``add_forces(scene, dt) -> int`` after the sphere--sphere and sphere--wall forces: it adds
-      its contact forces and torques to ``scene.device_state().force/torque`` and returns its
-      number of contacts.
+    * ``add_forces(scene, dt) -> int``: it adds its contact forces and torques at t + dt to
+      ``scene.device_state().external_force/external_torque`` and returns its number of contacts.
+      The one-launch step that follows adds them to the sphere--sphere and sphere--wall forces
+      (:mod:`.fused_step`).
 
     ``contact_moduli`` lists the effective Young's moduli [Pa] of its contacts with the spheres so
     that the scene's stable time step accounts for them.
@@ -149,6 +153,11 @@ class Scene:
         Steps between health checks (NaN, escaped particles, energy blow-up).
     arch:
         Taichi backend (``"cpu"`` default, ``"cuda"``...); see :func:`wheelsoil.granular.runtime.init`.
+    periodic_x:
+        Make the domain periodic along x with period ``domain_max[0] - domain_min[0]``: a sphere leaving
+        one end comes back at the other, and spheres near the two ends touch across it (nearest-image
+        distances, :func:`.neighbors.nearest_image`). :meth:`add_box_walls` then adds no end walls.
+        The period must hold at least three neighbour cells (3 (2 r_max + skin)).
     """
 
     def __init__(
@@ -164,6 +173,7 @@ class Scene:
         impact_speed: float = 1.0,
         check_interval: int = 200,
         arch: str | None = None,
+        periodic_x: bool = False,
     ) -> None:
         self.domain_min = _as_array("domain_min", domain_min, (3,), 1)[0]
         self.domain_max = _as_array("domain_max", domain_max, (3,), 1)[0]
@@ -187,6 +197,8 @@ class Scene:
             raise WheelsoilInputError(f"check_interval = {check_interval!r} must be >= 1")
         self._skin_request = skin
         self._cell_request = cell_size
+        self.periodic_x = bool(periodic_x)
+        self.period = float(self.domain_max[0] - self.domain_min[0]) if self.periodic_x else 0.0
         self.impact_speed = float(impact_speed)
         self.check_interval = int(check_interval)
         self.arch = runtime.init(arch)
@@ -206,6 +218,7 @@ class Scene:
         self._v = np.zeros((0, 3))
         self._w = np.zeros((0, 3))
         self._r = np.zeros(0)
+        self._mobile = np.zeros(0)  # 1: integrated; 0: held in place (see hold)
         self._f = np.zeros((0, 3))
         self._t = np.zeros((0, 3))
         self._hist: dict | None = None  # pair list with tangential history, wall history (host copy)
@@ -254,16 +267,14 @@ class Scene:
         material: Material | None = STEEL,
         pair: PairProperties = SOIL_STEEL,
     ) -> list[int]:
-        """Floor and four side walls of the box ``[lo, hi]`` (default: the domain); ``top`` adds a lid."""
+        """Floor and four side walls of the box ``[lo, hi]`` (default: the domain); ``top`` adds a lid.
+        A scene periodic along x gets no walls at the two ends along x."""
         lo = self.domain_min if lo is None else _as_array("lo", lo, (3,), 1)[0]
         hi = self.domain_max if hi is None else _as_array("hi", hi, (3,), 1)[0]
-        planes = [
-            (lo, (0, 0, 1)),
-            (lo, (1, 0, 0)),
-            (hi, (-1, 0, 0)),
-            (lo, (0, 1, 0)),
-            (hi, (0, -1, 0)),
-        ]
+        planes = [(lo, (0, 0, 1))]
+        if not self.periodic_x:
+            planes += [(lo, (1, 0, 0)), (hi, (-1, 0, 0))]
+        planes += [(lo, (0, 1, 0)), (hi, (0, -1, 0))]
         if top:
             planes.append((hi, (0, 0, -1)))
         return [self.add_wall(p, n, material=material, pair=pair) for p, n in planes]
@@ -284,12 +295,14 @@ class Scene:
     def device_state(self) -> DeviceState:
         """The device arrays the scene steps (moves the state to the device if needed)."""
         d = self._to_device()
-        return DeviceState(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["f"], d["t"])
+        return DeviceState(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["f"], d["t"], d["f_ext"], d["t_ext"])
 
-    def add_spheres(self, positions, radii, velocities=None, angular_velocities=None) -> slice:
+    def add_spheres(self, positions, radii, velocities=None, angular_velocities=None, *, wall_history=None) -> slice:
         """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
 
         Returns the slice of particle indices they received. Every sphere must lie inside the domain.
+        ``wall_history``: (N, walls, 3) tangential displacements [m] of their wall contacts (default none);
+        pair histories are set with :meth:`set_contact_history`.
         """
         x = _as_array("positions", positions, (3,))
         n = x.shape[0]
@@ -301,6 +314,9 @@ class Scene:
             raise WheelsoilInputError(f"radius {float(r[bad[0]])!r} m of sphere {int(bad[0])} is invalid: radii must be > 0")
         v = np.zeros((n, 3)) if velocities is None else _as_array("velocities", velocities, (3,), n)
         w = np.zeros((n, 3)) if angular_velocities is None else _as_array("angular_velocities", angular_velocities, (3,), n)
+        if self.periodic_x:
+            x = x.copy()
+            x[:, 0] = self._wrapped(x[:, 0])
         outside = np.flatnonzero(np.any((x < self.domain_min) | (x > self.domain_max), axis=1))
         if outside.size:
             k = int(outside[0])
@@ -314,20 +330,100 @@ class Scene:
         self._v = np.concatenate([self._v, v])
         self._w = np.concatenate([self._w, w])
         self._r = np.concatenate([self._r, r])
+        self._mobile = np.concatenate([self._mobile, np.ones(n)])
         self._f = np.concatenate([self._f, np.zeros((n, 3))])
         self._t = np.concatenate([self._t, np.zeros((n, 3))])
+        if wall_history is not None:
+            wall_history = np.asarray(wall_history, float)
+            if wall_history.shape != (n, len(self.walls), 3):
+                raise WheelsoilInputError(f"wall_history has shape {wall_history.shape}; expected ({n}, {len(self.walls)}, 3)")
+        if self._hist is None and wall_history is not None:
+            self._hist = self._empty_history(start)
         if self._hist is not None:  # new spheres have no pairs yet; existing indices are unchanged
             h = self._hist
-            h["xi_wall"] = np.concatenate([h["xi_wall"], np.zeros((n,) + h["xi_wall"].shape[1:])])
+            rows = np.zeros((n,) + h["xi_wall"].shape[1:]) if wall_history is None else wall_history
+            h["xi_wall"] = np.concatenate([h["xi_wall"], rows])
+        if start:
+            self._renumbered(np.concatenate([np.arange(start), np.full(n, -1)]))
         return slice(start, start + n)
 
+    def _wrapped(self, xs: np.ndarray) -> np.ndarray:
+        """x coordinates brought into [domain_min x, domain_min x + period) (periodic scenes)."""
+        u = np.mod(np.asarray(xs, float) - self.domain_min[0], self.period)
+        u[u >= self.period] -= self.period
+        return self.domain_min[0] + u
+
+    def translate(self, offset) -> None:
+        """Move every sphere by ``offset`` [m] (a 3-vector); a periodic scene wraps them back into its period.
+
+        Contact histories are kept (a rigid translation changes no contact). Used by a moving soil patch
+        that keeps the wheel near the middle of a periodic bin (:mod:`wheelsoil.coupling.patch`).
+        """
+        off = _as_array("offset", offset, (3,), 1)[0]
+        self._to_host()
+        x = self._x + off
+        if self.periodic_x:
+            x[:, 0] = self._wrapped(x[:, 0])
+        outside = np.flatnonzero(np.any((x < self.domain_min) | (x > self.domain_max), axis=1))
+        if outside.size:
+            raise WheelsoilInputError(f"translating by {off.tolist()} m moves {outside.size} spheres out of the domain")
+        self._x = x
+
+    def _empty_history(self, n: int) -> dict:
+        return {"pair_i": np.zeros(0, np.int32), "pair_j": np.zeros(0, np.int32), "pair_xi": np.zeros((0, 3)),
+                "xi_wall": np.zeros((n, len(self.walls), 3))}
+
+    def contact_history(self) -> dict:
+        """The tangential contact history as NumPy arrays: ``pair_i``, ``pair_j`` (i < j, sorted by i then j),
+        ``pair_xi`` (pairs, 3) [m] (zero for pairs listed but apart) and ``xi_wall`` (N, walls, 3) [m]."""
+        self._to_host()
+        h = self._hist if self._hist is not None else self._empty_history(self.n_particles)
+        return {k: v.copy() for k, v in h.items()}
+
+    def set_contact_history(self, pair_i, pair_j, pair_xi) -> None:
+        """Give the sphere pairs (pair_i[k], pair_j[k]) the tangential displacements pair_xi[k] [m] (replacing
+        what they had): a contact of spheres placed at rest in a state that had it (a prepared bed's).
+
+        pair_xi[k] is the displacement as sphere pair_i[k] sees it (the force pass's owner convention); a pair
+        given with pair_i > pair_j is turned around (its displacement negated)."""
+        i = np.asarray(pair_i, np.int64).ravel()
+        j = np.asarray(pair_j, np.int64).ravel()
+        xi = np.asarray(pair_xi, float).reshape(-1, 3)
+        n = self.n_particles
+        if not (len(i) == len(j) == len(xi)) or (len(i) and (min(i.min(), j.min()) < 0 or max(i.max(), j.max()) >= n)):
+            raise WheelsoilInputError(f"pair history: pair_i, pair_j (indices below {n}) and pair_xi (pairs, 3) must "
+                                      "have one row per pair")
+        if np.any(i == j):
+            raise WheelsoilInputError("pair history: a sphere cannot pair with itself")
+        self._to_host()
+        h = self._hist if self._hist is not None else self._empty_history(n)
+        lo, hi = np.minimum(i, j), np.maximum(i, j)
+        xi = np.where((i > j)[:, None], -xi, xi)
+        all_i = np.concatenate([lo, h["pair_i"]])
+        all_j = np.concatenate([hi, h["pair_j"]])
+        all_xi = np.concatenate([xi, h["pair_xi"]])
+        keys = all_i * n + all_j
+        _, first = np.unique(keys, return_index=True)  # the given rows come first: they win
+        order = first[np.lexsort((all_j[first], all_i[first]))]
+        h["pair_i"], h["pair_j"] = all_i[order].astype(np.int32), all_j[order].astype(np.int32)
+        h["pair_xi"] = all_xi[order]
+        self._hist = h
+
+    def _renumbered(self, old_of_new: np.ndarray) -> None:
+        """Tell the interactions that sphere k is now the former sphere old_of_new[k] (-1: a new one)."""
+        for body in self.interactions:
+            hook = getattr(body, "renumber", None)
+            if hook is not None:
+                hook(self, old_of_new)
+
     def keep_spheres(self, mask) -> None:
-        """Keep only the spheres where ``mask`` is true (contact history of kept pairs is preserved)."""
+        """Keep only the spheres where ``mask`` is true (contact history of kept pairs is preserved,
+        also that of interactions with a ``renumber(scene, old_of_new)`` method)."""
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != (self.n_particles,):
             raise WheelsoilInputError(f"mask has shape {mask.shape}; expected ({self.n_particles},)")
         self._to_host()
-        for name in ("_x", "_v", "_w", "_r", "_f", "_t"):
+        for name in ("_x", "_v", "_w", "_r", "_mobile", "_f", "_t"):
             setattr(self, name, getattr(self, name)[mask])
         if self._hist is not None:
             h = self._hist
@@ -338,6 +434,24 @@ class Scene:
             h["pair_i"], h["pair_j"] = pi[kept].astype(np.int32), pj[kept].astype(np.int32)
             h["pair_xi"] = h["pair_xi"][kept]
             h["xi_wall"] = h["xi_wall"][mask]
+        self._renumbered(np.flatnonzero(mask))
+
+    def hold(self, mask) -> None:
+        """Hold the spheres where ``mask`` is true in place (zero velocity and spin; they still push on the
+        others, as a wall of spheres would) and set all others free. A moving soil patch holds the spheres
+        at the ends of its bin, so that the soil leans on the packing it continues, not on a flat wall."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != (self.n_particles,):
+            raise WheelsoilInputError(f"mask has shape {mask.shape}; expected ({self.n_particles},)")
+        self._to_host()
+        self._mobile = np.where(mask, 0.0, 1.0)
+        self._v[mask] = 0.0
+        self._w[mask] = 0.0
+
+    @property
+    def held(self) -> np.ndarray:
+        """Which spheres are held in place (:meth:`hold`), (N,) bool."""
+        return self._mobile == 0.0
 
     def set_velocities(self, velocities=None, angular_velocities=None) -> None:
         """Overwrite translational [m/s] and/or angular [rad/s] velocities, (N, 3) each."""
@@ -403,20 +517,26 @@ class Scene:
         d = self._to_device()
         gx, gy, gz = (float(c) for c in self.gravity)
         half_skin2 = (0.5 * d["skin"]) ** 2
-        # Without interactions the force pass, the closing half kick and the next step's opening
-        # kick and drift run as one launch (fused_step), except before a step whose state is read.
-        fused = self.fuse_steps and not self.interactions
+        # The force pass, the closing half kick and the next step's opening kick and drift run as one
+        # launch (fused_step), except before a step whose state is read; interactions evaluate their
+        # contacts between the drift and that launch.
+        fused = self.fuse_steps
         drifted = False
         largest = 0.0
         for k in range(n):
             if not drifted:
                 integrator.kick_drift_graph(
-                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt, d["x_ref"],
+                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], d["mobile"], gx, gy, gz, dt, d["x_ref"],
                     d["r"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
                 )
                 largest = float(d["step_result"][0])
             if largest > half_skin2:
                 self._rebuild_neighbors()
+            n_external = 0
+            for body in self.interactions:
+                body.after_drift(self, dt)
+            for body in self.interactions:
+                n_external += int(body.add_forces(self, dt))
             if fused:
                 step_number = self.steps_taken + 1
                 state_read = (
@@ -425,14 +545,11 @@ class Scene:
                     or (callback is not None and callback_every and (k + 1) % callback_every == 0)
                 )
                 self._n_contacts, largest = self._contact_step(dt, gx, gy, gz, drift=not state_read)
+                self._n_contacts += n_external
                 drifted = not state_read
             else:
-                for body in self.interactions:
-                    body.after_drift(self, dt)
-                self._n_contacts = self._compute_forces(dt)
-                for body in self.interactions:
-                    self._n_contacts += int(body.add_forces(self, dt))
-                integrator.kick_graph(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], gx, gy, gz, dt)
+                self._n_contacts = self._compute_forces(dt) + n_external
+                integrator.kick_graph(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], d["mobile"], gx, gy, gz, dt)
             self.time += dt
             self.steps_taken += 1
             if self.steps_taken % self.check_interval == 0:
@@ -444,12 +561,13 @@ class Scene:
         d = self._dev
         pairs = d["pairs"]
         fused_step.contact_step_graph(
-            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"],
+            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["mobile"],
             pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["f"], d["t"], gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
+            d["period"], d["inv_period"], int(bool(self.interactions)), d["f_ext"], d["t_ext"], d["f"], d["t"],
+            gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
         )
         result = d["step_result"]
         return int(result[0]), float(result[1])
@@ -463,7 +581,8 @@ class Scene:
             d["rev_start"],
             d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
             d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["f"], d["t"], d["step_result"],
+            d["period"], d["inv_period"], int(bool(self.interactions)), d["f_ext"], d["t_ext"], d["f"], d["t"],
+            d["step_result"],
         )
         return int(d["step_result"][0])
 
@@ -477,21 +596,25 @@ class Scene:
         exactly this state: a scene restored from it (:meth:`restore_state`) steps bit for bit like this one.
         """
         self._to_host()
-        out = {"x": self._x, "v": self._v, "w": self._w, "f": self._f, "t": self._t, "r": self._r}
+        out = {"x": self._x, "v": self._v, "w": self._w, "f": self._f, "t": self._t, "r": self._r,
+               "mobile": self._mobile}
         for key, value in (self._hist or {}).items():
             out[f"hist_{key}"] = value
         out.update({k: getattr(self, k) for k in self._STATE_SCALARS})
         return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.items()}
 
-    def restore_state(self, state: dict) -> None:
-        """Continue from a :meth:`state` of a scene with the same spheres and walls."""
+    def restore_state(self, state: dict, *, same_spheres: bool = True) -> None:
+        """Continue from a :meth:`state` of a scene with the same spheres and walls (``same_spheres=False``:
+        the state may hold other spheres, e.g. a moving soil patch's; the walls must be the same)."""
         r = np.asarray(state["r"], float)
-        if r.shape != self._r.shape or not np.array_equal(r, self._r):
+        if same_spheres and (r.shape != self._r.shape or not np.array_equal(r, self._r)):
             raise WheelsoilInputError(
                 f"the saved state has {len(r)} spheres of other radii than this scene's {self.n_particles}; "
                 "it belongs to another bed"
             )
         self._dev = None
+        self._r = r.copy()
+        self._mobile = np.array(state["mobile"], float) if "mobile" in state else np.ones(len(r))
         self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
         self._f, self._t = np.array(state["f"], float), np.array(state["t"], float)
         hist = {k[5:]: np.array(v) for k, v in state.items() if k.startswith("hist_")}
@@ -506,10 +629,10 @@ class Scene:
         """
         d = self._to_device()
         out = d["health"]
-        integrator.state_health(
-            d["x"], d["v"], d["w"], d["m"], d["I"],
-            self.domain_min.tolist(), self.domain_max.tolist(), out,
-        )
+        lo, hi = self.domain_min.tolist(), self.domain_max.tolist()
+        if self.periodic_x:  # centres wrap at each rebuild; in between they may cross the ends
+            lo[0], hi[0] = -math.inf, math.inf
+        integrator.state_health(d["x"], d["v"], d["w"], d["m"], d["I"], lo, hi, out)
         bad, outside, vmax2, energy = out.to_numpy()
         where = f"at t = {self.time:.6g} s (step {self.steps_taken})"
         if bad:
@@ -546,7 +669,17 @@ class Scene:
                 f"cell_size = {cell!r} m is smaller than the interaction reach 2 r_max + skin = {reach:.4g} m"
             )
         extent = self.domain_max - self.domain_min
+        if self.periodic_x:
+            # cubic cells whose edge divides the period exactly, so that the cells wrap around in x
+            along = int(math.floor(self.period / cell * (1 + 1e-12)))
+            if along < 3:
+                raise WheelsoilInputError(
+                    f"the periodic length {self.period:g} m holds {along} neighbour cells of {cell:.4g} m; it must "
+                    f"hold at least 3 (a period of at least {3 * cell:.4g} m)")
+            cell = self.period / along
         dims = np.maximum(1, np.ceil(extent / cell).astype(np.int64))
+        if self.periodic_x:
+            dims[0] = along
         if int(np.prod(dims)) > 2**31 - 2:
             raise WheelsoilInputError(f"neighbour grid of {dims.tolist()} cells is too large; raise cell_size")
         width = neighbor_row_width(r_min, r_max, skin)
@@ -561,6 +694,8 @@ class Scene:
             "e_eff": effective_modulus(self.material, self.material),
             "g_eff": effective_shear_modulus(self.material, self.material),
             "beta": self.pair.damping_ratio,
+            "period": self.period,
+            "inv_period": 1.0 / self.period if self.period > 0 else 0.0,
         }
 
         def vec(a):
@@ -576,8 +711,10 @@ class Scene:
 
         d["x"], d["v"], d["w"] = vec(self._x), vec(self._v), vec(self._w)
         d["f"], d["t"] = vec(self._f), vec(self._t)
+        d["f_ext"], d["t_ext"] = vec(np.zeros((n, 3))), vec(np.zeros((n, 3)))
         d["x_ref"] = vec(self._x)
         d["r"] = scal(self._r)
+        d["mobile"] = scal(self._mobile)
         d["m"] = scal(mass)
         d["I"] = scal(0.4 * mass * self._r**2)
         # the contact view: (x, r), (v, m), (omega, I) side by side for the force pass
@@ -657,6 +794,8 @@ class Scene:
     def _rebuild_neighbors(self) -> None:
         d = self._dev
         origin = self.domain_min.tolist()
+        if self.periodic_x:
+            neighbors.wrap_positions(d["x"], d["x_r"], origin[0], self.period)
         inv_cell = 1.0 / d["cell"]
         neighbors.bin_particles(d["x"], origin, inv_cell, d["dims"], d["cell_of"], d["cell_count"])
         neighbors.exclusive_scan(d["cell_count"], d["cell_start"])
@@ -665,7 +804,7 @@ class Scene:
         def build_rows() -> int:
             return neighbors.build_neighbor_lists(
                 d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
-                d["nbr"], d["count"],
+                d["period"], d["inv_period"], d["nbr"], d["count"],
             )
 
         most = build_rows()
