@@ -48,7 +48,6 @@ import numpy as np
 import taichi as ti
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.flexwheel.integrator import HUB_POSITION
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.materials import (
     SOIL_STEEL,
@@ -135,7 +134,8 @@ class WheelContact(Interaction):
         self._facet_fill = ti.ndarray(ti.i32, shape=sf.n_facets)
         self._resultant = ti.Vector.ndarray(3, ti.f64, shape=5)
         self._resultant.fill(0.0)
-        self._stats = ti.ndarray(ti.f64, shape=1)
+        self._stats = ti.ndarray(ti.f64, shape=2)
+        self._contact_arrays = None  # the contact kernel's array arguments (set at each rebuild)
         self._arrays: dict = {}
         self._scene_key = None
         self._need_rebuild = True
@@ -183,7 +183,8 @@ class WheelContact(Interaction):
         self._need_rebuild = True
 
     def _rebuild(self, scene: Scene) -> None:
-        ds = scene.device_state()
+        ds = self._scene_state = scene.device_state()
+        self._contact_arrays = None
         w = self.structure.device_arrays()
         a = self._arrays
         sf = self.surface
@@ -228,25 +229,35 @@ class WheelContact(Interaction):
             self._attach(scene)
         if self._need_rebuild or scene.neighbor_rebuilds != self._seen_rebuilds:
             self._rebuild(scene)
-        ds = scene.device_state()
-        w = self.structure.device_arrays()
-        a = self._arrays
-        center = vec3(*w["hub"].to_numpy()[HUB_POSITION]) if self.structure.hub_nodes.size else vec3(0.0, 0.0, 0.0)
-        self._n_contacts = k.wheel_contacts(
-            ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.force, ds.torque,
-            self._n_active, a["active"], a["start"], a["cand"],
-            a["code"], a["keep"], a["bary"], a["normal"], a["overlap"], a["f_wheel"], a["m_wheel"], a["xi_new"], a["stiffness"],
-            a["hist_n"], a["hist_xi"], a["hist_count"],
-            w["x"], w["v"], w["w"], self._inv_mass, self._tri, self._edges, self._half_t,
-            self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
-            w["f_ext"], w["k_ext"], w["x_anchor"], self._node_ref, center, self._resultant,
+        self._launch_contacts(dt)
+        stats = self._stats.to_numpy()
+        self._n_contacts = int(stats[1])
+        # rebuild before the wheel's surface has moved its skin (less a margin for one more step)
+        if stats[0] > (0.8 * self.wheel_skin) ** 2:
+            self._need_rebuild = True
+        return self._n_contacts
+
+    def _launch_contacts(self, dt: float) -> None:
+        """One evaluation of every contact (:func:`.kernels.wheel_contacts`, as a compute graph); its array
+        arguments are gathered once per candidate rebuild."""
+        if self._contact_arrays is None:
+            ds = self._scene_state
+            w = self.structure.device_arrays()
+            a = self._arrays
+            self._contact_arrays = (
+                (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
+                (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
+                 a["f_wheel"], a["m_wheel"], a["xi_new"], a["stiffness"], a["hist_n"], a["hist_xi"], a["hist_count"],
+                 w["x"], w["v"], w["w"], self._inv_mass, self._tri, self._edges, self._half_t,
+                 self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
+                 w["f_ext"], w["k_ext"], w["x_anchor"], self._node_ref, w["hub"], self._resultant),
+            )
+        particles, rest = self._contact_arrays
+        k.wheel_contacts_graph(
+            *particles, self._n_active, *rest,
             self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
             dt, self._stats,
         )
-        # rebuild before the wheel's surface has moved its skin (less a margin for one more step)
-        if self._stats.to_numpy()[0] > (0.8 * self.wheel_skin) ** 2:
-            self._need_rebuild = True
-        return self._n_contacts
 
     # ------------------------------------------------------------------ measured quantities
     @property
@@ -287,6 +298,19 @@ class WheelContact(Interaction):
             for key in ("hist_n", "hist_xi", "hist_count"):
                 out[key] = self._arrays[key].to_numpy()
         return out
+
+    def renumber(self, scene: Scene, old_of_new: np.ndarray) -> None:
+        """The scene's spheres were renumbered (sphere k is the former ``old_of_new[k]``, -1 for a new one):
+        carry each sphere's contact history to its new index (called by the scene)."""
+        if not self._arrays or self._scene_key is None:
+            return
+        old = {key: self._arrays[key].to_numpy() for key in ("hist_n", "hist_xi", "hist_count")}
+        self._attach(scene)
+        keep = old_of_new >= 0
+        for key, values in old.items():
+            new = np.zeros((len(old_of_new),) + values.shape[1:], values.dtype)
+            new[keep] = values[old_of_new[keep]]
+            self._arrays[key].from_numpy(np.ascontiguousarray(new))
 
     def invalidate(self) -> None:
         """Rebuild the candidate lists at the next evaluation (after the scene's arrays were reset)."""

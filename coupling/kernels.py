@@ -6,18 +6,20 @@ Two kinds of work:
   uniform grid, list for every particle the facets within its reach plus a skin (its *candidates*,
   sorted by facet so that results do not depend on thread scheduling), compact the particles that
   have candidates into an *active* list, and transpose the candidate list per facet.
-* *Every step* (:func:`wheel_contacts`): per active particle, classify each candidate by the
-  Voronoi region of its closest point (face, edge, vertex), keep each physical contact once,
-  evaluate the Hertz--Mindlin law with the contact's tangential history, and add force and torque to
-  the particle; then per surface node gather the reactions of the contacts on its facets (the force
-  by barycentric weights plus the self-equilibrated nodal forces carrying the contact's moment; a
+* *Every step* (:func:`wheel_contacts`, one launch), in phases, each a Taichi function:
+  (A) :func:`candidate_geometry` -- per active particle, classify each candidate by the Voronoi region of
+  its closest point (face, edge, vertex); (B) :func:`counted_once` -- keep each physical contact once;
+  (C) the Hertz--Mindlin law with the contact's tangential history (:func:`matched_history`), force and
+  torque added to the particle, the contact's moment carried by :func:`facet_moment_forces`;
+  (D) :func:`node_load` -- per surface node, gather the reactions of the contacts on its facets (a
   gather: no floating-point atomics), with the contacts' normal stiffness lumped to the nodes (the
   structure lets the held force follow the node's motion within its sub-steps, which keeps light
-  nodes under stiff contacts stable), and sum the resultant on the wheel.
+  nodes under stiff contacts stable); then the resultant on the wheel.
 """
 
 import taichi as ti
 
+from wheelsoil.graph_launch import GraphKernel
 from wheelsoil.granular.contact import hertz_mindlin
 from wheelsoil.granular.neighbors import sort_run
 from wheelsoil.taichi_types import ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
@@ -183,11 +185,134 @@ def _has_node(tri: ti.template(), s: ti.i32, node: ti.i32) -> ti.i32:
     return ti.cast(tri[s, 0] == node or tri[s, 1] == node or tri[s, 2] == node, ti.i32)
 
 
+@ti.func
+def candidate_geometry(e: ti.i32, p: vec3, ri: ti.f64, cand: ti.template(), xw: ti.template(), tri: ti.template(),
+                       half_t: ti.template(), code: ti.template(), overlap: ti.template(), normal: ti.template(),
+                       bary: ti.template()):
+    """Phase A, candidate entry ``e`` of a sphere (centre p, radius ri): the closest feature of its facet
+    (face, edge or vertex; ``code`` -1 when they do not touch), the normal from the sphere towards the wheel
+    (the facet normal on the sphere's side, or along the separation) and the overlap r + h - distance."""
+    s = cand[e]
+    ca, cb, cc = _corners(xw, tri, s)
+    w, feature = closest_point_on_triangle(p, ca, cb, cc)
+    d = p - (w[0] * ca + w[1] * cb + w[2] * cc)
+    reach = ri + half_t[s]
+    n = vec3(0.0, 0.0, 1.0)
+    depth = 0.0
+    if feature == FACE:
+        nf = (cb - ca).cross(cc - ca).normalized()
+        sd = d.dot(nf)
+        n = -nf if sd >= 0.0 else nf
+        depth = reach - ti.abs(sd)
+    else:
+        dist = d.norm()
+        if dist > 0.0:
+            n = -d / dist
+        depth = reach - dist
+    code[e] = feature if depth > 0.0 else -1
+    overlap[e] = depth
+    normal[e] = n
+    for k in ti.static(range(3)):
+        bary[e, k] = w[k]
+
+
+@ti.func
+def counted_once(e: ti.i32, e0: ti.i32, e1: ti.i32, code: ti.template(), cand: ti.template(), edges: ti.template(),
+                 tri: ti.template()) -> ti.i32:
+    """Phase B: whether entry ``e`` is a physical contact of its own where facets share an edge or a vertex
+    (Kremmer & Favier 2001): a face contact always; an edge contact unless a facet with that edge has a face
+    contact or an earlier entry gave the same edge; a vertex contact unless a face or edge contact involves
+    that vertex or an earlier entry gave it."""
+    kept = 0
+    kind = code[e]
+    if kind == FACE:
+        kept = 1
+    elif kind >= EDGE_AB and kind <= EDGE_CA:
+        edge = edges[cand[e], kind - EDGE_AB]
+        kept = 1
+        for e2 in range(e0, e1):
+            k2 = code[e2]
+            s2 = cand[e2]
+            if k2 == FACE and _shares_edge(edges, s2, edge):
+                kept = 0
+            elif e2 < e and k2 >= EDGE_AB and k2 <= EDGE_CA and edges[s2, k2 - EDGE_AB] == edge:
+                kept = 0
+    elif kind >= VERTEX_A:
+        node = tri[cand[e], kind - VERTEX_A]
+        kept = 1
+        for e2 in range(e0, e1):
+            k2 = code[e2]
+            s2 = cand[e2]
+            if k2 == FACE and _has_node(tri, s2, node):
+                kept = 0
+            elif k2 >= EDGE_AB and k2 <= EDGE_CA:
+                j = k2 - EDGE_AB
+                if tri[s2, j] == node or tri[s2, (j + 1) % 3] == node:
+                    kept = 0
+            elif e2 < e and k2 >= VERTEX_A and tri[s2, k2 - VERTEX_A] == node:
+                kept = 0
+    return kept
+
+
+@ti.func
+def matched_history(i: ti.i32, n: vec3, is_face: ti.i32, n_old: ti.i32, claimed: ti.i32, hist_n: ti.template()) -> ti.i32:
+    """Phase C, history matching: the unclaimed history slot of sphere ``i`` whose normal is closest to n
+    (within 60 deg; a face contact matches either side), or -1 for a new contact."""
+    best = -1
+    best_score = 0.5  # cos 60 deg: a contact's normal turns far less in one step
+    for k in range(n_old):
+        if ((claimed >> k) & 1) == 0:
+            score = n.dot(hist_n[i, k])
+            if is_face:
+                score = ti.abs(score)
+            if score > best_score:
+                best_score = score
+                best = k
+    return best
+
+
+@ti.func
+def facet_moment_forces(s: ti.i32, xw: ti.template(), tri: ti.template(), moment: vec3) -> vec3:
+    """The vector lam whose nodal forces f_k = lam x s_k (s_k: corner k about the facet centroid) add up to
+    no force and to the moment ``moment``: J lam = M with J = sum_k (|s_k|^2 I - s_k s_k^T)."""
+    centroid = (xw[tri[s, 0]] + xw[tri[s, 1]] + xw[tri[s, 2]]) / 3.0
+    jac = ti.Matrix.zero(ti.f64, 3, 3)
+    for q in ti.static(range(3)):
+        sk = xw[tri[s, q]] - centroid
+        jac += sk.dot(sk) * ti.Matrix.identity(ti.f64, 3) - sk.outer_product(sk)
+    return jac.inverse() @ moment
+
+
+@ti.func
+def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corners: ti.template(),
+              facet_start: ti.template(), facet_entries: ti.template(), keep: ti.template(), bary: ti.template(),
+              f_wheel: ti.template(), m_wheel: ti.template(), stiffness: ti.template(), xw: ti.template(),
+              tri: ti.template(), f_ext: ti.template(), k_ext: ti.template(), x_anchor: ti.template()):
+    """Phase D, surface node ``u``: gather the reactions of the kept contacts on its facets (barycentric share
+    of the force, plus the moment's nodal force lam x arm) and their lumped normal stiffness; a gather, so
+    no two threads write one node."""
+    node = nodes[u]
+    f = vec3(0.0)
+    stiff = 0.0
+    for q in range(corner_start[u], corner_start[u + 1]):
+        s = corners[q] // 3
+        k = corners[q] % 3
+        arm = xw[node] - (xw[tri[s, 0]] + xw[tri[s, 1]] + xw[tri[s, 2]]) / 3.0
+        for j in range(facet_start[s], facet_start[s + 1]):
+            e = facet_entries[j]
+            if keep[e]:
+                f += bary[e, k] * f_wheel[e] + m_wheel[e].cross(arm)
+                stiff += bary[e, k] * stiffness[e]
+    f_ext[node] = f
+    k_ext[node] = stiff
+    x_anchor[node] = xw[node]
+
+
 @ti.kernel
 def wheel_contacts(
     # particles
     x: nd_vec3, v: nd_vec3, omega: nd_vec3, radius: nd_f64, mass: nd_f64, inertia: nd_f64,
-    force: nd_vec3, torque: nd_vec3,
+    ext_force: nd_vec3, ext_torque: nd_vec3,
     # candidates
     n_active: ti.i32, active: nd_i32, start: nd_i32, cand: nd_i32,
     # per-entry scratch
@@ -198,84 +323,28 @@ def wheel_contacts(
     # wheel
     xw: nd_vec3, vw: nd_vec3, ww: nd_vec3, inv_mass_w: nd_f64, tri: nd_i32_2d, edges: nd_i32_2d, half_t: nd_f64,
     nodes: nd_i32, corner_start: nd_i32, corners: nd_i32, facet_start: nd_i32, facet_entries: nd_i32,
-    f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, node_ref: nd_vec3, center: vec3, resultant: nd_vec3,
+    f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, node_ref: nd_vec3, hub: nd_vec3, resultant: nd_vec3,
     # contact law
     e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, dt: ti.f64,
     stats: nd_f64,
-) -> ti.i32:
-    """One evaluation of every particle--wheel contact; returns the number of contacts.
+):
+    """One evaluation of every particle--wheel contact (phases A--D above, then the resultant).
 
-    ``stats[0]`` receives the largest squared displacement of a surface node since the last rebuild.
+    Writes to ``stats``: [0] the largest squared displacement of a surface node since the last rebuild,
+    [1] the number of contacts (it runs as a compute graph, which cannot return values). The resultant's
+    moment is taken about the hub centre, read from ``hub`` (row 0; zeros for a structure without a hub).
     """
     n_contacts = 0
-    for _ in range(1):
-        stats[0] = 0.0
     for a in range(n_active):
         i = active[a]
         p = x[i]
         ri = radius[i]
         e0 = start[i]
         e1 = start[i + 1]
-        # (A) geometry of each candidate: closest feature, normal (particle -> wheel), overlap
         for e in range(e0, e1):
-            s = cand[e]
-            ca, cb, cc = _corners(xw, tri, s)
-            w, feature = closest_point_on_triangle(p, ca, cb, cc)
-            d = p - (w[0] * ca + w[1] * cb + w[2] * cc)
-            reach = ri + half_t[s]
-            kind = -1
-            n = vec3(0.0, 0.0, 1.0)
-            depth = 0.0
-            if feature == FACE:
-                nf = (cb - ca).cross(cc - ca).normalized()
-                sd = d.dot(nf)
-                n = -nf if sd >= 0.0 else nf
-                depth = reach - ti.abs(sd)
-            else:
-                dist = d.norm()
-                if dist > 0.0:
-                    n = -d / dist
-                depth = reach - dist
-            if depth > 0.0:
-                kind = feature
-            code[e] = kind
-            overlap[e] = depth
-            normal[e] = n
-            for k in ti.static(range(3)):
-                bary[e, k] = w[k]
-        # (B) count each physical contact once where facets share an edge or a vertex
+            candidate_geometry(e, p, ri, cand, xw, tri, half_t, code, overlap, normal, bary)
         for e in range(e0, e1):
-            kept = 0
-            kind = code[e]
-            if kind == FACE:
-                kept = 1
-            elif kind >= EDGE_AB and kind <= EDGE_CA:
-                s = cand[e]
-                edge = edges[s, kind - EDGE_AB]
-                kept = 1
-                for e2 in range(e0, e1):
-                    k2 = code[e2]
-                    s2 = cand[e2]
-                    if k2 == FACE and _shares_edge(edges, s2, edge):
-                        kept = 0
-                    elif e2 < e and k2 >= EDGE_AB and k2 <= EDGE_CA and edges[s2, k2 - EDGE_AB] == edge:
-                        kept = 0
-            elif kind >= VERTEX_A:
-                s = cand[e]
-                node = tri[s, kind - VERTEX_A]
-                kept = 1
-                for e2 in range(e0, e1):
-                    k2 = code[e2]
-                    s2 = cand[e2]
-                    if k2 == FACE and _has_node(tri, s2, node):
-                        kept = 0
-                    elif k2 >= EDGE_AB and k2 <= EDGE_CA:
-                        j = k2 - EDGE_AB
-                        if tri[s2, j] == node or tri[s2, (j + 1) % 3] == node:
-                            kept = 0
-                    elif e2 < e and k2 >= VERTEX_A and tri[s2, k2 - VERTEX_A] == node:
-                        kept = 0
-            keep[e] = kept
+            keep[e] = counted_once(e, e0, e1, code, cand, edges, tri)
         # (C) Hertz--Mindlin on each kept contact, history matched by contact normal
         f_total = vec3(0.0)
         t_total = vec3(0.0)
@@ -287,16 +356,7 @@ def wheel_contacts(
                 s = cand[e]
                 n = normal[e]
                 depth = overlap[e]
-                best = -1
-                best_score = 0.5  # cos 60 deg: a contact's normal turns far less in one step
-                for k in range(n_old):
-                    if ((claimed >> k) & 1) == 0:
-                        score = n.dot(hist_n[i, k])
-                        if code[e] == FACE:
-                            score = ti.abs(score)
-                        if score > best_score:
-                            best_score = score
-                            best = k
+                best = matched_history(i, n, ti.cast(code[e] == FACE, ti.i32), n_old, claimed, hist_n)
                 xi = vec3(0.0)
                 if best >= 0:
                     claimed |= 1 << best
@@ -328,21 +388,14 @@ def wheel_contacts(
                 stiffness[e] = 2.0 * e_eff * ti.sqrt(ri * depth)  # S_n = dF_n/d(delta_n)
                 # The moment the wheel must also receive for angular momentum to balance exactly: the
                 # particle's torque about the origin is (p + r n) x F + M_roll, the wheel receives -F at
-                # ``point``. It goes to the facet's nodes as a self-equilibrated set of forces (no nodal
-                # moments: a shell node's small rotary inertia would make them stiff):
-                # f_k = lam x s_k, s_k = x_k - centroid, J lam = M, J = sum(|s_k|^2 I - s_k s_k^T).
-                moment = -m_roll - (p + ri * n - point).cross(fc)
-                centroid = (xw[i0] + xw[i1] + xw[i2]) / 3.0
-                jac = ti.Matrix.zero(ti.f64, 3, 3)
-                for q in ti.static(range(3)):
-                    sk = xw[tri[s, q]] - centroid
-                    jac += sk.dot(sk) * ti.Matrix.identity(ti.f64, 3) - sk.outer_product(sk)
-                m_wheel[e] = jac.inverse() @ moment
+                # ``point``; it goes to the facet's nodes as a self-equilibrated set of forces (no nodal
+                # moments: a shell node's small rotary inertia would make them stiff).
+                m_wheel[e] = facet_moment_forces(s, xw, tri, -m_roll - (p + ri * n - point).cross(fc))
                 normal[e] = n
                 xi_new[e] = xi_out
                 n_kept += 1
         n_contacts += n_kept
-        # (D) the history of this step's contacts
+        # the history of this step's contacts
         slots = 0
         for e in range(e0, e1):
             if keep[e] and slots < hist_n.shape[1]:
@@ -350,29 +403,17 @@ def wheel_contacts(
                 hist_xi[i, slots] = xi_new[e]
                 slots += 1
         hist_count[i] = slots
-        force[i] += f_total
-        torque[i] += t_total
-    # nodes gather the reactions of the contacts on their facets
+        ext_force[i] += f_total
+        ext_torque[i] += t_total
+    largest = 0.0
     for u in nodes:
-        node = nodes[u]
-        f = vec3(0.0)
-        stiff = 0.0
-        for q in range(corner_start[u], corner_start[u + 1]):
-            s = corners[q] // 3
-            k = corners[q] % 3
-            arm = xw[node] - (xw[tri[s, 0]] + xw[tri[s, 1]] + xw[tri[s, 2]]) / 3.0
-            for j in range(facet_start[s], facet_start[s + 1]):
-                e = facet_entries[j]
-                if keep[e]:
-                    f += bary[e, k] * f_wheel[e] + m_wheel[e].cross(arm)
-                    stiff += bary[e, k] * stiffness[e]
-        f_ext[node] = f
-        k_ext[node] = stiff
-        x_anchor[node] = xw[node]
-        ti.atomic_max(stats[0], (xw[node] - node_ref[u]).norm_sqr())
-    # resultant on the wheel: force and moment about ``center`` (serial sum: deterministic)
+        node_load(u, nodes, corner_start, corners, facet_start, facet_entries, keep, bary, f_wheel, m_wheel,
+                  stiffness, xw, tri, f_ext, k_ext, x_anchor)
+        ti.atomic_max(largest, (xw[nodes[u]] - node_ref[u]).norm_sqr())
+    # resultant on the wheel: force and moment about the hub centre (serial sum: deterministic)
     ti.loop_config(serialize=True)
     for _ in range(1):
+        center = hub[0]
         f = vec3(0.0)
         m = vec3(0.0)
         for u in range(nodes.shape[0]):
@@ -384,4 +425,9 @@ def wheel_contacts(
         resultant[RES_FORCE_SUM] += f
         resultant[RES_MOMENT_SUM] += m
         resultant[RES_SAMPLES] += vec3(1.0, 0.0, 0.0)
-    return n_contacts
+        stats[0] = largest
+        stats[1] = n_contacts
+
+
+#: :func:`wheel_contacts` as a compute graph (same arguments; :mod:`wheelsoil.graph_launch`).
+wheel_contacts_graph = GraphKernel(wheel_contacts)

@@ -4,16 +4,36 @@ Rig kinematics (architecture conventions; seed 004 eqs. 14--16):
 
 * wheel frame: x along the heading, y along the axle, z up; the carriage travels along the bin's +X;
   the wheel is yawed by -beta so that the steering (slip) angle beta lies between heading and travel;
-* prescribed wheel spin omega about the axle; travel speed from the commanded slip,
-  v_x = (1 - i) r omega along the heading and v_y = v_x tan(beta) across it (global speed v_x / cos beta);
+* the hub spins at omega about the axle; the carriage travels at v_x = (1 - i) r omega along the heading
+  and v_y = v_x tan(beta) across it (global speed v_x / cos beta): i and beta are the *commanded* slip and
+  slip angle, those of the hub;
 * the axle is free vertically under the constant load W: the rig applies W - m g downwards at the hub
   so the total load on the soil is W at any gravity (m: wheel mass including the hub), and a viscous
   damper on the vertical slide (``axle_damping``) keeps the wheel's heave from ringing.
 
-Protocol: place the wheel with its lowest point just above the highest sphere beneath it; lower it at
-``lowering_speed`` until the soil carries the load W, then release the axle (free vertically under W)
-and let it settle (``settle_time``); spin up to omega and drive (``drive_time``); detect the steady
-state and average over it.
+A flexible wheel winds up under torque: the tread lags the hub by a twist that grows with the torque,
+and while it grows the tread turns slower than the hub, so the slip the soil sees -- the **tread slip**,
+from the tread's own measured rotation (:mod:`.kinematics`) -- is lower than the commanded one. Every
+sample records both. A true steady state has the tread turning at the hub's rate again.
+
+Protocol:
+
+1. *lower*: the wheel, its lowest point just above the highest sphere beneath it, is lowered at
+   ``lowering_speed`` until the soil carries the load W;
+2. *settle*: the axle is released (free vertically under W) and the wheel rests for ``settle_time``;
+3. *spin-up*: omega and the carriage speed ramp up together over ``spin_up_time``;
+4. *wind-up* (``windup="controller"``): the carriage keeps its speed while the hub's spin follows
+   omega_h = omega + K (omega - omega_t) (K = ``windup_gain``, omega_t the tread's spin, filtered over
+   ``windup_filter``; omega_h held within omega (1 +- 0.5)), which winds the wheel up to the twist the
+   torque needs K + 1 times faster than the constant spin would (the wind-up is a first-order lag of
+   time constant c / k_t, c the soil's d torque / d omega_t and k_t the wheel's torsional stiffness;
+   with the feedback it is c / ((K + 1) k_t)). It ends when the tread's spin over the last pitch is
+   within ``slip_tolerance`` / 3 (in slip) of the commanded one; ``windup="none"``: no wind-up phase;
+5. *drive*: the hub spins at exactly omega -- the rig's command -- and the run goes on until a steady
+   window of at least ``average_time`` is found (:mod:`.steady`: whole pitches of the tread's rotation;
+   forces, torque, sinkage and tread slip without drift; tread slip within ``slip_tolerance`` of the
+   commanded slip), or until ``drive_time`` has passed since the spin-up ended (then the summary says the
+   run is not steady, and why). ``stop_when_steady=False`` drives the whole ``drive_time``.
 
 Measured quantities (wheel frame, from the contact resultant, time-averaged over each sample interval):
 drawbar pull DP = F.x (net soil force along the heading), lateral force F.y, vertical force F.z,
@@ -21,7 +41,8 @@ driving torque T = -M.y (the torque the motor supplies against the soil's moment
 sinkage = surface height + r - hub height (hub drop below where the undeformed tread touches the
 levelled surface; it includes the wheel's deflection), tread sinkage = surface height - lowest point of
 the tread's mid-surface (the depth of the rut the tread presses, without the deflection; grousers reach
-deeper), achieved slip and slip angle from the hub's velocity.
+deeper), the commanded slip and slip angle from the hub's velocity and spin, and the tread's wind-up,
+spin, slip and slip angle.
 """
 
 from __future__ import annotations
@@ -37,10 +58,13 @@ from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
-from wheelsoil.granular.bed import Bed
+from wheelsoil.granular.bed import Bed, BedSpec
 from wheelsoil.granular.materials import SOIL_STEEL, PairProperties
+from wheelsoil.granular.timestep import estimate_time_step
 
 from .contact import WheelContact
+from .kinematics import TreadTracker, deformation, slip_angle_deg
+from .steady import SteadyState, detect_steady_state
 
 #: Series recorded at every sample, with units.
 SERIES_UNITS = {
@@ -53,16 +77,23 @@ SERIES_UNITS = {
     "tread_sinkage": "m",
     "slip": "1",
     "slip_angle": "deg",
+    "tread_slip": "1",
+    "tread_slip_angle": "deg",
+    "wind_up": "rad",
+    "tread_omega": "rad/s",
     "load": "N",
     "omega": "rad/s",
+    "travel": "m",
     "hub_x": "m",
     "hub_y": "m",
     "hub_z": "m",
     "contacts": "1",
 }
-#: Quantities averaged over the steady state.
-STEADY_QUANTITIES = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage", "slip",
-                     "slip_angle")
+#: Quantities whose drift the steady-state detector checks (the tread slip is checked on its own).
+STEADY_CHECKED = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage")
+#: Quantities averaged over the steady window.
+STEADY_QUANTITIES = STEADY_CHECKED + ("tread_sinkage", "slip", "slip_angle", "tread_slip_angle", "wind_up")
+PHASES = ("new", "lower", "settle", "spin-up", "wind-up", "drive", "done")
 
 
 def _check(key: str, value, ok: bool, allowed: str) -> None:
@@ -74,18 +105,29 @@ def _check(key: str, value, ok: bool, allowed: str) -> None:
 class TestbedSpec:
     """What the rig does (SI units, angles in degrees).
 
-    slip: longitudinal slip i = 1 - v_x / (r omega), in [-1, 1) (negative: braking).
+    slip: commanded longitudinal slip i = 1 - v_x / (r omega), in [-1, 1) (negative: braking).
     slip_angle: steering angle beta between heading and travel [deg], in (-90, 90).
     load: vertical load W on the soil, wheel weight included [N], > 0.
     angular_velocity: wheel spin omega [rad/s], > 0 (seed 004: r omega = 0.6 m/s).
     lowering_speed: speed [m/s] at which the rig lowers the wheel onto the soil until the soil carries W.
     settle_time: time the wheel then rests, free vertically under W, before driving [s].
     spin_up_time: time over which omega (and the carriage speed) rise linearly [s].
-    drive_time: time driven at constant omega [s].
+    drive_time: longest drive after the spin-up [s]; the run ends sooner once steady (``stop_when_steady``).
+    stop_when_steady: end the run at the first steady window of ``average_time``.
+    average_time: shortest averaging window once steady [s] (rounded up to whole periods of the tread, at
+        least three: :func:`wheel_period`).
+    windup: ``"controller"`` (wind the wheel up by tread-speed feedback on the hub, then hold omega) or
+        ``"none"`` (hold omega from the spin-up on).
+    windup_gain: feedback gain K of the wind-up controller (> 0).
+    windup_filter: time constant [s] of the filter on the tread's measured spin in the controller.
+    max_wind_up: the twist [rad] beyond which the run stops with an error (spokes buckling through).
     sample_interval: averaging interval of one sample of the time series [s].
-    steady_window: shortest span [s] compared when detecting the steady state.
-    steady_tolerance: relative change allowed between the two halves of the steady span.
-    start_x: initial hub position along the bin [m] (default: one wheel radius plus 0.1 m from the start).
+    steady_tolerance: largest drift over the window allowed for a steady quantity, relative to
+        max(|mean|, floor) (floors: 5 % of W for forces, 5 % of W r for the torque, half a mean particle
+        diameter for the sinkage).
+    slip_tolerance: largest difference between the tread slip and the commanded slip in a steady window.
+    start_x: initial hub position along the bin [m] (default: one wheel radius plus 0.1 m from the start;
+        on a periodic bed, as near the start as the moving patch allows).
     rigid: use the rigid wheel with the same surface instead of the flexible one.
     damping: mass-proportional structural damping of the flexible wheel [1/s], relative to the hub.
     axle_damping: viscous damper on the rig's vertical slide [N s/m], acting on the hub's vertical speed
@@ -94,6 +136,10 @@ class TestbedSpec:
         stiffness from ringing through the run; its force is updated every sample interval. None: wheel
         mass / 0.1 s (a free heave decays in 0.1 s; roughly 0.4 of critical damping for the smoke case's
         heave on the soil); 0: no damper.
+    patch_shift: on a periodic bed, the moving soil patch re-centres the wheel whenever it has travelled
+        this far [m] (:mod:`.patch`); None: a fifth of the wheel radius.
+    time_step: DEM time step of the run [s] (None: the bed's stable estimate); the bed is prepared with its own,
+        so a time-step study tests the same bed. A step above the stable estimate is refused.
     pair: soil--wheel contact properties (default seed 004 Table 1 soil--steel).
     """
 
@@ -106,38 +152,56 @@ class TestbedSpec:
     lowering_speed: float = 0.3
     settle_time: float = 0.1
     spin_up_time: float = 0.05
-    drive_time: float = 1.0
+    drive_time: float = 4.0
+    stop_when_steady: bool = True
+    average_time: float = 1.0
+    windup: str = "controller"
+    windup_gain: float = 4.0
+    windup_filter: float = 0.04
+    max_wind_up: float = 0.6
     sample_interval: float = 0.005
-    steady_window: float = 0.15
-    steady_tolerance: float = 0.15
+    steady_tolerance: float = 0.1
+    slip_tolerance: float = 0.03
     start_x: float | None = None
     rigid: bool = False
     damping: float = 10.0
     axle_damping: float | None = None
+    patch_shift: float | None = None
+    time_step: float | None = None
     pair: PairProperties = field(default_factory=lambda: SOIL_STEEL)
 
     def __post_init__(self) -> None:
-        fin = lambda v: isinstance(v, (int, float)) and math.isfinite(v)  # noqa: E731
+        fin = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)  # noqa: E731
         _check("slip", self.slip, fin(self.slip) and -1.0 <= self.slip < 1.0, "-1 <= slip < 1")
         _check("slip_angle", self.slip_angle, fin(self.slip_angle) and -90.0 < self.slip_angle < 90.0,
                "-90 < slip_angle < 90 deg")
         _check("load", self.load, fin(self.load) and self.load > 0.0, "load > 0 N")
         _check("angular_velocity", self.angular_velocity, fin(self.angular_velocity) and self.angular_velocity > 0.0,
                "angular_velocity > 0 rad/s")
-        for key in ("lowering_speed", "settle_time", "drive_time", "sample_interval", "steady_window",
-                    "steady_tolerance"):
+        for key in ("lowering_speed", "settle_time", "drive_time", "sample_interval", "average_time",
+                    "steady_tolerance", "slip_tolerance", "windup_gain", "windup_filter", "max_wind_up"):
             v = getattr(self, key)
             _check(key, v, fin(v) and v > 0.0, f"{key} > 0")
         for key in ("spin_up_time", "damping"):
             v = getattr(self, key)
             _check(key, v, fin(v) and v >= 0.0, f"{key} >= 0")
-        _check("spin_up_time", self.spin_up_time, self.spin_up_time < self.drive_time,
-               f"spin_up_time < drive_time = {self.drive_time}")
+        _check("windup", self.windup, self.windup in ("controller", "none"), "'controller' or 'none'")
+        _check("max_wind_up", self.max_wind_up, self.max_wind_up <= math.pi / 2, "max_wind_up <= pi/2 rad")
+        _check("average_time", self.average_time, self.average_time < self.drive_time,
+               f"average_time < drive_time = {self.drive_time} s")
+        _check("sample_interval", self.sample_interval, self.sample_interval <= 0.25 * self.average_time,
+               f"sample_interval <= average_time / 4 = {0.25 * self.average_time:g} s")
         if self.axle_damping is not None:
             _check("axle_damping", self.axle_damping, fin(self.axle_damping) and self.axle_damping >= 0.0,
                    "axle_damping >= 0 N s/m, or None for wheel mass / 0.1 s")
         if self.start_x is not None:
             _check("start_x", self.start_x, fin(self.start_x) and self.start_x > 0.0, "start_x > 0 m")
+        if self.patch_shift is not None:
+            _check("patch_shift", self.patch_shift, fin(self.patch_shift) and self.patch_shift > 0.0,
+                   "patch_shift > 0 m, or None for a fifth of the wheel radius")
+        if self.time_step is not None:
+            _check("time_step", self.time_step, fin(self.time_step) and self.time_step > 0.0,
+                   "time_step > 0 s, or None for the bed's stable estimate")
         if not isinstance(self.pair, PairProperties):
             raise WheelsoilInputError(f"testbed pair must be a PairProperties, got {type(self.pair).__name__}")
 
@@ -166,40 +230,60 @@ class TestbedResult:
     info: dict = field(default_factory=dict)
     final_particles: dict = field(default_factory=dict)
     final_wheel_nodes: np.ndarray | None = None
+    final_deformation: np.ndarray | None = None
     mesh: StructureMesh | None = None
 
     def steady(self, name: str) -> float:
-        """Steady-state mean of a quantity (see :data:`STEADY_QUANTITIES`)."""
+        """Steady-state mean of a quantity (see :data:`STEADY_QUANTITIES`, and ``tread_slip``)."""
         return float(self.summary[name]["mean"])
 
 
-def detect_steady_state(t: np.ndarray, values: dict, *, start: float, window: float, tolerance: float,
-                        scales: dict) -> tuple[int, bool]:
-    """First sample index from which every series in ``values`` is stationary.
+def wheel_period(wheel: WheelGeometry) -> float:
+    """The angle [rad] after which the wheel repeats itself: the grouser pitch and the spoke pitch both divide
+    it (their least common multiple when one is a whole multiple of the other, else the grouser pitch; the
+    spoke pitch for a smooth wheel). The batch of the steady-state statistics: the forces of a spoked wheel ride
+    on its periodic stiffness (seed 000 eq. 19) as well as on the grousers."""
+    spoke = math.radians(wheel.spoke_pitch)
+    if not wheel.grouser_count:
+        return spoke
+    grouser = 2.0 * math.pi / wheel.grouser_count
+    for small, large in ((grouser, spoke), (spoke, grouser)):
+        ratio = large / small
+        if abs(ratio - round(ratio)) < 1e-9:
+            return large
+    return grouser
 
-    A span [t_k, t_end] (at least two ``window``s long, beginning at or after ``start``) is steady
-    when, for every series, the means of its first and second halves differ by at most
-    ``tolerance`` x max(|mean|, scale). Candidates are tried from ``start`` onwards in steps of half a
-    window; returns (index, True) for the first steady span, or (index of the last half of the drive,
-    False) when none is.
-    """
-    t = np.asarray(t)
-    end = t[-1]
-    candidates = np.arange(start, end - 2 * window + 1e-12, 0.5 * window)
-    for t0 in candidates:
-        k0 = int(np.searchsorted(t, t0))
-        mid = k0 + (len(t) - k0) // 2
-        ok = True
-        for name, y in values.items():
-            a, b = np.mean(y[k0:mid]), np.mean(y[mid:])
-            scale = max(abs(np.mean(y[k0:])), scales.get(name, 0.0))
-            if abs(a - b) > tolerance * scale:
-                ok = False
-                break
-        if ok:
-            return k0, True
-    k_start = int(np.searchsorted(t, start))
-    return k_start + (len(t) - k_start) // 2, False
+
+def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
+    """Check that the wheel fits the bin and that the bin (or the moving patch on a periodic bin) holds the drive,
+    before any bed is prepared; returns the hub's start position along the bin [m]. The errors name the case keys
+    and values."""
+    from .patch import PatchGeometry
+
+    beta = math.radians(spec.slip_angle)
+    outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
+    # footprint across the bin: the width turned by beta plus a contact length of about one radius
+    footprint = wheel.width * math.cos(beta) + wheel.radius * abs(math.sin(beta))
+    if wheel.width >= bed.width or footprint >= bed.width - 2 * bed.diameter_max:
+        raise WheelsoilInputError(
+            f"wheel {wheel.name!r} (width {wheel.width} m, footprint {footprint:.3f} m across the bin at "
+            f"slip_angle {spec.slip_angle} deg) does not fit the bed width {bed.width} m "
+            f"(allowed footprint < {bed.width - 2 * bed.diameter_max:.3f} m)"
+        )
+    if bed.periodic:
+        shift = spec.patch_shift or 0.2 * wheel.radius
+        return PatchGeometry.for_wheel(bed.length, outer, shift, bed.diameter_max).check(spec.start_x)
+    speed = (1.0 - spec.slip) * wheel.radius * spec.angular_velocity / math.cos(beta)
+    travel = abs(speed) * (spec.drive_time + spec.spin_up_time)
+    start_x = spec.start_x if spec.start_x is not None else outer + 0.1
+    if start_x - outer < 0 or start_x + travel + outer > bed.length:
+        raise WheelsoilInputError(
+            f"the bin (soil.length = {bed.length} m) is too short for test.drive_time = {spec.drive_time} s: "
+            f"the wheel (outer radius {outer:.3f} m) starts at x = {start_x:.3f} m and may travel "
+            f"{travel:.3f} m at {speed:.3f} m/s; shorten drive_time, use a longer bin, or a "
+            "periodic bed (soil.periodic = true: a moving soil patch holds any drive)"
+        )
+    return start_x
 
 
 class Testbed:
@@ -208,7 +292,7 @@ class Testbed:
     Parameters
     ----------
     bed: a prepared :class:`~wheelsoil.granular.Bed` or the path of a bed HDF5 file; it was prepared
-        under the gravity the test runs at.
+        under the gravity the test runs at. A periodic bed (``BedSpec.periodic``) makes a moving soil patch.
     wheel: the wheel geometry (e.g. ``flexwheel.geometry.LUNAR_ROVER.with_element_size(0.05)``).
     spec: the rig settings (:class:`TestbedSpec`).
     arch: Taichi backend.
@@ -231,27 +315,19 @@ class Testbed:
         bs = bed.spec
         beta = math.radians(spec.slip_angle)
         outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
-        # footprint across the bin: the width turned by beta plus a contact length of about one radius
-        footprint = wheel.width * math.cos(beta) + wheel.radius * abs(math.sin(beta))
-        if wheel.width >= bs.width or footprint >= bs.width - 2 * bs.diameter_max:
-            raise WheelsoilInputError(
-                f"wheel {wheel.name!r} (width {wheel.width} m, footprint {footprint:.3f} m across the bin at "
-                f"slip_angle {spec.slip_angle} deg) does not fit the bed width {bs.width} m "
-                f"(allowed footprint < {bs.width - 2 * bs.diameter_max:.3f} m)"
-            )
-        g = -float(bs.gravity[2])
-        self.gravity = g
-        v_x = (1.0 - spec.slip) * wheel.radius * spec.angular_velocity
-        self.travel_speed = v_x / math.cos(beta)  # along the bin
-        travel = abs(self.travel_speed) * spec.drive_time
-        start_x = spec.start_x if spec.start_x is not None else outer + 0.1
-        end_x = start_x + travel + outer
-        if start_x - outer < 0 or end_x > bs.length:
-            raise WheelsoilInputError(
-                f"the bin (length {bs.length} m) is too short: the wheel (outer radius {outer:.3f} m) starts at "
-                f"x = {start_x:.3f} m and travels {travel:.3f} m in drive_time = {spec.drive_time} s "
-                f"at {self.travel_speed:.3f} m/s; shorten drive_time or use a longer bed"
-            )
+        self.outer_radius = outer
+        self.gravity = -float(bs.gravity[2])
+        self.travel_speed = (1.0 - spec.slip) * wheel.radius * spec.angular_velocity / math.cos(beta)  # along the bin
+        self.periodic = bool(bs.periodic)
+        start_x = check_fits(bs, wheel, spec)
+        if self.periodic:
+            from .patch import MovingPatch
+
+            self.patch = MovingPatch(bed, wheel_reach=outer, shift=spec.patch_shift or 0.2 * wheel.radius)
+            self.patch.check_start(start_x)
+        else:
+            self.patch = None
+        self.start_x = start_x
 
         # ---- the wheel, yawed by -beta and placed just above the surface
         mesh, hub_nodes = build_wheel_mesh(wheel)
@@ -276,24 +352,38 @@ class Testbed:
         self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / 0.1
         self.heading = self.yaw[:, 0]
         self.axle = self.yaw[:, 1]
+        self.tracker = TreadTracker(mesh.nodes[self._tread_nodes], self.heading, self.axle,
+                                    weights=self.structure.mass[self._tread_nodes])
+        self.pitch = wheel_period(wheel)
 
         # ---- the soil and the contact interface
         headroom = max(bs.depth, 0.25)
-        self.scene = bed.to_scene(headroom=headroom, arch=arch)
+        self.scene = bed.to_scene(headroom=headroom, arch=arch, periodic_x=False, end_walls=self.patch is None)
+        if self.patch is not None:
+            self.patch.start(self.scene)
         self.contact = WheelContact(self.structure, bs.material, spec.pair)
         self.scene.add_interaction(self.contact)
+        if spec.time_step is not None:
+            # the run's own DEM step (the bed was prepared with its stable estimate, so a time-step study
+            # tests the same bed)
+            self.scene.time_step = spec.time_step
         self.dt = self.scene.time_step
         self.steps_per_sample = max(1, int(round(spec.sample_interval / self.dt)))
         self.structure.drive_hub(velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                                  free_translation=(False, False, False), free_rotation=(False, False, False))
         self._loop: dict | None = None
         self.rows: dict | None = None
+        self.steady_state: SteadyState | None = None
 
-    # ------------------------------------------------------------------ the run
-    def _drive(self, omega: float) -> None:
-        """Spin omega about the axle and the carriage speed that gives the commanded slip."""
-        v = (1.0 - self.spec.slip) * self.wheel.radius * omega / math.cos(math.radians(self.spec.slip_angle))
-        self.structure.drive_hub(velocity=(v, 0.0, 0.0), angular_velocity=omega * self.axle)
+    # ------------------------------------------------------------------ the rig's commands
+    @property
+    def carriage_velocity(self) -> float:
+        """The carriage's speed along the bin [m/s] at full spin (commanded slip and slip angle)."""
+        return self.travel_speed
+
+    def _command(self, hub_spin: float, carriage: float) -> None:
+        """Spin the hub at ``hub_spin`` about the axle and move the carriage at ``carriage`` along the bin."""
+        self.structure.drive_hub(velocity=(carriage, 0.0, 0.0), angular_velocity=hub_spin * self.axle)
 
     def _release(self) -> None:
         """Free the axle vertically under the load W (the rig applies W - m g downwards)."""
@@ -306,112 +396,209 @@ class Testbed:
         push = -(self.spec.load - self.wheel_mass * self.gravity) - self.axle_damping * vertical_speed
         self.structure.drive_hub(force=(0.0, 0.0, push))
 
+    # ------------------------------------------------------------------ the run
     def run(self, *, progress: bool = False, on_sample=None) -> TestbedResult:
-        """Run the protocol (lower, settle, drive); returns the time series and the steady-state summary.
+        """Run the protocol (lower, settle, spin up, wind up, drive); returns the series and the summary.
 
         ``on_sample(testbed)``, if given, is called after every sample (the rows so far are in
         :attr:`rows`); a run restored with :meth:`restore_state` continues where its checkpoint was taken.
+        ``progress``: show a progress bar (rich) on the terminal.
         """
-        s = self.spec
-        sample = self.steps_per_sample * self.dt
         if self._loop is None:
-            self._loop = {"phase": "lower", "t_drive": math.inf, "t_settled": math.inf, "wall": 0.0}
-            self.rows = {k: [] for k in SERIES_UNITS}
-            self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
-            self.contact.mean_resultant(reset=True)
-        loop, rows = self._loop, self.rows
-        if loop["phase"] == "done":
+            self._start()
+        if self._loop["phase"] == "done":
             raise WheelsoilInputError("this testbed has finished its run; build a new Testbed to run again")
-        surface = self.bed.surface_height
-        max_sinkage = 0.5 * self.wheel.radius
-        wall = time.perf_counter() - loop["wall"]
-        bar = task = None
-        if progress:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
-
-            bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
-                           TimeElapsedColumn(), TimeRemainingColumn(), transient=True)
-            bar.start()
-            total = None
-            if loop["phase"] != "lower":
-                total = int(math.ceil((loop["t_settled"] + s.drive_time - self.scene.time) / sample)) + len(rows["t"])
-            task = bar.add_task("testbed", total=total, completed=len(rows["t"]))
+        wall = time.perf_counter() - self._loop["wall"]
+        bar = _ProgressBar(self) if progress else None
         try:
-            while True:
-                phase = loop["phase"]
-                t = self.scene.time
-                if phase == "drive":
-                    ramp = min(1.0, (t - loop["t_drive"]) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
-                    self._drive(s.angular_velocity * ramp)
-                if phase != "lower" and self.axle_damping > 0.0:
-                    self._apply_load(float(self.structure.hub_velocity[2]))
-                self.scene.step(self.steps_per_sample)
-                force, moment, _ = self.contact.mean_resultant(reset=True)
-                hub = self.structure.hub_position
-                vel = self.structure.hub_velocity
-                vx, vy = float(vel @ self.heading), float(vel @ self.axle)
-                spin = self.structure.hub_angular_velocity @ self.axle
-                row = {
-                    "t": self.scene.time,
-                    "drawbar_pull": force @ self.heading,
-                    "lateral_force": force @ self.axle,
-                    "vertical_force": force[2],
-                    "torque": -(moment @ self.axle),
-                    "sinkage": surface + self.wheel.radius - hub[2],
-                    "tread_sinkage": surface - float(self.structure.positions()[self._tread_nodes, 2].min()),
-                    "slip": 1.0 - vx / (self.wheel.radius * spin) if spin > 0 else 0.0,
-                    "slip_angle": math.degrees(math.atan2(vy, vx)) if abs(vx) > 1e-12 else 0.0,
-                    "load": s.load if phase != "lower" else 0.0,
-                    "omega": spin,
-                    "hub_x": hub[0], "hub_y": hub[1], "hub_z": hub[2],
-                    "contacts": self.contact.contact_count,
-                }
-                for key, val in row.items():
-                    rows[key].append(float(val))
-                finished = False
-                if phase == "lower":
-                    if force[2] >= s.load:
-                        self._release()
-                        loop["phase"], loop["t_settled"] = "settle", self.scene.time + s.settle_time
-                        if bar is not None:
-                            bar.update(task, total=int(math.ceil((s.settle_time + s.drive_time) / sample)) + len(rows["t"]))
-                    elif row["sinkage"] > max_sinkage:
-                        raise SimulationUnstableError(
-                            f"the bed does not carry the load {s.load} N: the wheel sank {row['sinkage']:.3f} m "
-                            f"(more than half its radius) while lowered, with the soil carrying {force[2]:.1f} N"
-                        )
-                elif phase == "settle" and self.scene.time >= loop["t_settled"] - 1e-12:
-                    loop["phase"], loop["t_drive"] = "drive", self.scene.time
-                elif phase == "drive" and self.scene.time >= loop["t_drive"] + s.drive_time - 1e-12:
-                    finished = True
+            while not self._sample():
                 if bar is not None:
-                    bar.update(task, advance=1, description=(
-                        f"{phase:6s} t = {self.scene.time:.3f} s  DP {row['drawbar_pull']:8.1f} N  "
-                        f"Fz {row['vertical_force']:8.1f} N  sinkage {1e3 * row['sinkage']:6.1f} mm"))
-                if finished:
-                    break
+                    bar.update()
                 if on_sample is not None:
-                    loop["wall"] = time.perf_counter() - wall
+                    self._loop["wall"] = time.perf_counter() - wall
                     on_sample(self)
         finally:
             if bar is not None:
                 bar.stop()
         self.scene.check_health()
         self.structure.check_health()
-        loop["phase"] = "done"
-        self.phase_times = {"released": loop["t_settled"] - s.settle_time, "drive_start": loop["t_drive"]}
-        return self._result({k: np.asarray(v) for k, v in rows.items()}, time.perf_counter() - wall)
+        self._loop["phase"] = "done"
+        return self._result({k: np.asarray(v) for k, v in self.rows.items()}, time.perf_counter() - wall)
 
-    # ------------------------------------------------------------------ checkpoints
-    @property
-    def samples_taken(self) -> int:
-        return len(self.rows["t"]) if self.rows else 0
+    def _start(self) -> None:
+        s = self.spec
+        self._loop = {"phase": "lower", "t_release": math.inf, "t_spin": math.inf, "t_windup": math.inf,
+                      "t_hold": math.inf, "wall": 0.0, "hub_angle": 0.0, "omega_filtered": 0.0,
+                      "hub_spin": 0.0, "shift": 0.0, "next_check": math.inf, "windup_converged": False}
+        self.rows = {k: [] for k in SERIES_UNITS}
+        self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
+        self.contact.mean_resultant(reset=True)
 
     @property
     def phase(self) -> str:
-        """Where the protocol is: 'new', 'lower', 'settle', 'drive' or 'done'."""
+        """Where the protocol is: one of :data:`PHASES`."""
         return self._loop["phase"] if self._loop else "new"
 
+    def _set_drive(self) -> None:
+        """The hub's spin and the carriage's speed for the sample about to be taken."""
+        s, loop = self.spec, self._loop
+        t = self.scene.time
+        phase = loop["phase"]
+        omega = s.angular_velocity
+        if phase == "spin-up":
+            ramp = min(1.0, (t - loop["t_spin"]) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
+            spin, carriage = omega * ramp, self.travel_speed * ramp
+        elif phase == "wind-up":
+            spin = omega + s.windup_gain * (omega - loop["omega_filtered"])
+            spin, carriage = min(max(spin, 0.5 * omega), 1.5 * omega), self.travel_speed
+        elif phase == "drive":
+            spin, carriage = omega, self.travel_speed
+        else:
+            return
+        loop["hub_spin"] = spin
+        self._command(spin, carriage)
+
+    def _sample(self) -> bool:
+        """Advance one sample interval, record it and move the protocol on; True when the run is over."""
+        s, loop, rows = self.spec, self._loop, self.rows
+        self._set_drive()
+        phase = loop["phase"]
+        if phase != "lower" and self.axle_damping > 0.0:
+            self._apply_load(float(self.structure.hub_velocity[2]))
+        self.scene.step(self.steps_per_sample)
+        interval = self.steps_per_sample * self.dt
+        loop["hub_angle"] += loop["hub_spin"] * interval
+        row = self._measure(phase, interval)
+        for key, val in row.items():
+            rows[key].append(float(val))
+        if abs(row["wind_up"]) > s.max_wind_up:
+            raise SimulationUnstableError(
+                f"the wheel wound up by {math.degrees(row['wind_up']):.1f} deg at t = {row['t']:.3f} s, past "
+                f"test.max_wind_up = {s.max_wind_up:g} rad ({math.degrees(s.max_wind_up):.0f} deg): the tread lags "
+                f"the hub under {row['torque']:.0f} N m of torque (spokes buckling through?); a stiffer wheel, a "
+                "lower load or slip, or a larger test.max_wind_up if the twist is real")
+        if self.patch is not None and phase != "lower":
+            loop["shift"] += self.patch.update(self)
+        return self._advance_phase(row)
+
+    def _measure(self, phase: str, interval: float) -> dict:
+        s, loop, rows = self.spec, self._loop, self.rows
+        force, moment, _ = self.contact.mean_resultant(reset=True)
+        hub = self.structure.hub_position
+        vel = self.structure.hub_velocity
+        spin = float(self.structure.hub_angular_velocity @ self.axle)
+        nodes = self.structure.positions()
+        tread = self.tracker.state(nodes[self._tread_nodes], self.structure.hub_rotation)
+        tread_angle = loop["hub_angle"] - tread.wind_up
+        previous = loop.get("tread_angle", tread_angle)
+        loop["tread_angle"] = tread_angle
+        tread_omega = (tread_angle - previous) / interval
+        loop["omega_filtered"] += (tread_omega - loop["omega_filtered"]) * min(1.0, interval / s.windup_filter)
+        vx = float(vel @ self.heading)
+        vx_tread = float(vel @ tread.heading)
+        r = self.wheel.radius
+        return {
+            "t": self.scene.time,
+            "drawbar_pull": force @ self.heading,
+            "lateral_force": force @ self.axle,
+            "vertical_force": force[2],
+            "torque": -(moment @ self.axle),
+            "sinkage": self.bed.surface_height + r - hub[2],
+            "tread_sinkage": self.bed.surface_height - float(nodes[self._tread_nodes, 2].min()),
+            "slip": 1.0 - vx / (r * spin) if spin > 0 else 0.0,
+            "slip_angle": slip_angle_deg(vel, self.heading, self.axle),
+            "tread_slip": 1.0 - vx_tread / (r * tread_omega) if tread_omega > 0 else 0.0,
+            "tread_slip_angle": slip_angle_deg(vel, tread.heading, tread.axle),
+            "wind_up": tread.wind_up,
+            "tread_omega": tread_omega,
+            "load": s.load if phase != "lower" else 0.0,
+            "omega": spin,
+            "travel": hub[0] + loop["shift"] - self.start_x,
+            "hub_x": hub[0], "hub_y": hub[1], "hub_z": hub[2],
+            "contacts": self.contact.contact_count,
+        }
+
+    def _advance_phase(self, row: dict) -> bool:
+        s, loop = self.spec, self._loop
+        t = self.scene.time
+        phase = loop["phase"]
+        if phase == "lower":
+            if row["vertical_force"] >= s.load:
+                self._release()
+                loop["phase"], loop["t_release"] = "settle", t
+            elif row["sinkage"] > 0.5 * self.wheel.radius:
+                raise SimulationUnstableError(
+                    f"the bed does not carry the load {s.load} N: the wheel sank {row['sinkage']:.3f} m "
+                    f"(more than half its radius) while lowered, with the soil carrying {row['vertical_force']:.1f} N")
+        elif phase == "settle" and t >= loop["t_release"] + s.settle_time - 1e-12:
+            loop["phase"], loop["t_spin"] = "spin-up", t
+            loop["omega_filtered"] = 0.0
+        elif phase == "spin-up" and t >= loop["t_spin"] + s.spin_up_time - 1e-12:
+            loop["t_windup"] = t
+            if s.windup == "controller" and not s.rigid:  # a rigid wheel has nothing to wind up
+                loop["phase"] = "wind-up"
+            else:
+                self._hold(t)
+        elif phase == "wind-up":
+            if self._wound_up() or t >= loop["t_windup"] + 0.5 * s.drive_time:
+                loop["windup_converged"] = self._wound_up()
+                self._hold(t)
+        elif phase == "drive" and t >= loop["next_check"] - 1e-12:
+            loop["next_check"] = t + self.pitch / s.angular_velocity
+            ended = t >= loop["t_windup"] + s.drive_time - 1e-12
+            if s.stop_when_steady or ended:
+                self.steady_state = self._detect()
+                done = self.steady_state.steady and self._window_long_enough(self.steady_state)
+                if (done and s.stop_when_steady) or ended:
+                    return True
+        return False
+
+    def _hold(self, t: float) -> None:
+        """End the wind-up: from now on the hub spins at exactly omega."""
+        loop = self._loop
+        loop["phase"], loop["t_hold"] = "drive", t
+        # the first window may start one whole period after the hold (the hub's step from the controller's
+        # spin to omega is a small disturbance the wheel rides out within a period)
+        loop["t_average_from"] = t + self.pitch / self.spec.angular_velocity
+        loop["next_check"] = loop["t_average_from"] + self.spec.average_time
+
+    def _wound_up(self) -> bool:
+        """The tread's spin over its last pitch gives the commanded slip within a third of the tolerance."""
+        s, rows = self.spec, self.rows
+        omega_t = np.asarray(rows["tread_omega"])
+        t = np.asarray(rows["t"])
+        n_pitch = int(math.ceil(self.pitch / s.angular_velocity / (self.steps_per_sample * self.dt)))
+        if len(t) < n_pitch or t[-n_pitch] < self._loop["t_windup"]:
+            return False
+        mean_spin = float(omega_t[-n_pitch:].mean())
+        # slip error from a spin error: d i = (1 - i) d omega / omega
+        slip_error = (1.0 - s.slip) * abs(mean_spin - s.angular_velocity) / s.angular_velocity
+        spin_error = (1.0 - s.slip) * abs(self._loop["hub_spin"] - s.angular_velocity) / s.angular_velocity
+        return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
+
+    def _window_long_enough(self, state: SteadyState) -> bool:
+        return state.window[1] - state.window[0] >= self.spec.average_time * (1.0 - 1e-9)
+
+    def _detect(self) -> SteadyState:
+        s, rows = self.spec, self.rows
+        series = {q: np.asarray(rows[q]) for q in STEADY_CHECKED}
+        d_mean = 0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max)
+        floors = {"drawbar_pull": 0.05 * s.load, "lateral_force": 0.05 * s.load, "vertical_force": 0.05 * s.load,
+                  "torque": 0.05 * s.load * self.wheel.radius, "sinkage": 0.5 * d_mean}
+        t = np.asarray(rows["t"])
+        # the tread angle from its per-sample spin, and the travel speed along the tread's heading (the v_x
+        # of the tread slip i_t = 1 - v_x / (r omega_t), recovered from the two series)
+        omega_t = np.asarray(rows["tread_omega"])
+        heading_speed = (1.0 - np.asarray(rows["tread_slip"])) * self.wheel.radius * omega_t
+        angle = np.cumsum(omega_t * self.steps_per_sample * self.dt)
+        min_pitches = int(math.ceil(s.average_time * s.angular_velocity / self.pitch))
+        return detect_steady_state(
+            t, series, tread_angle=angle, travel_speed=heading_speed, radius=self.wheel.radius, pitch=self.pitch,
+            start=self._loop.get("t_average_from", math.inf), min_pitches=min_pitches,
+            tolerance=s.steady_tolerance, floors=floors, slip_target=s.slip, slip_tolerance=s.slip_tolerance,
+            sample_interval=self.steps_per_sample * self.dt)
+
+    # ------------------------------------------------------------------ checkpoints
     def state(self) -> dict:
         """The whole state of a run between two samples: NumPy arrays and scalars, enough to continue it.
 
@@ -423,8 +610,9 @@ class Testbed:
             raise WheelsoilInputError("a testbed state can only be taken during a run (from on_sample)")
         state = {"scene": self.scene.state(), "structure": self.structure.state(), "contact": self.contact.state()}
         self.contact.invalidate()
-        loop = dict(self._loop)
-        state["testbed"] = {"loop": loop, "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
+        state["testbed"] = {"loop": dict(self._loop), "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
+        if self.patch is not None:
+            state["patch"] = self.patch.state()
         return state
 
     def restore_state(self, state: dict) -> None:
@@ -432,28 +620,42 @@ class Testbed:
         rows = state["testbed"]["rows"]
         if set(rows) != set(SERIES_UNITS):
             raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
-        self.scene.restore_state(state["scene"])
+        self.scene.restore_state(state["scene"], same_spheres=self.patch is None)
         self.structure.restore_state(state["structure"])
         self.contact.restore_state(self.scene, state["contact"])
+        if self.patch is not None:
+            self.patch.restore_state(state["patch"])
         self._loop = dict(state["testbed"]["loop"])
         self.rows = {k: [float(v) for v in np.asarray(rows[k])] for k in SERIES_UNITS}
 
+    # ------------------------------------------------------------------ the result
     def _result(self, rows: dict, wall: float) -> TestbedResult:
-        s = self.spec
+        s, loop = self.spec, self._loop
+        state = self.steady_state if self.steady_state is not None else self._detect()
         t = rows["t"]
-        drive_start = self.phase_times["drive_start"] + s.spin_up_time
-        d_mean = 0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max)
-        k0, steady = detect_steady_state(
-            t, {q: rows[q] for q in ("drawbar_pull", "vertical_force", "torque", "sinkage")},
-            start=drive_start, window=s.steady_window, tolerance=s.steady_tolerance,
-            scales={"drawbar_pull": 0.05 * s.load, "vertical_force": 0.05 * s.load,
-                    "torque": 0.05 * s.load * self.wheel.radius, "sinkage": 0.5 * d_mean},
-        )
-        summary = {"window": [float(t[k0]), float(t[-1])], "steady": bool(steady), "samples": int(len(t) - k0)}
+        k0, k1 = state.k0, state.k1
+        if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
+            k1 = len(t)
+            k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
+        summary = {
+            "steady": bool(state.steady), "window": [float(t[k0] - self.steps_per_sample * self.dt), float(t[k1 - 1])],
+            "samples": int(k1 - k0), "pitches": int(state.pitches), "pitch_deg": math.degrees(self.pitch),
+            "reasons": list(state.reasons), "commanded_slip": s.slip, "commanded_slip_angle": s.slip_angle,
+        }
         for q in STEADY_QUANTITIES:
-            y = rows[q][k0:]
-            summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "units": SERIES_UNITS[q]}
+            y = rows[q][k0:k1]
+            st = state.stats.get(q, {})
+            summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
+                          "drift": float(st.get("drift", math.nan)), "units": SERIES_UNITS[q]}
+        ts = state.stats.get("tread_slip")
+        if ts is not None:
+            summary["tread_slip"] = {**{k: float(v) for k, v in ts.items()}, "units": "1"}
+        else:
+            summary["tread_slip"] = {"mean": float(np.mean(rows["tread_slip"][k0:k1])),
+                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan,
+                                     "drift": math.nan, "units": "1"}
         particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
+        nodes = self.structure.positions()
         info = {
             "wall_seconds": wall,
             "simulated_seconds": float(t[-1]),
@@ -467,8 +669,52 @@ class Testbed:
             "wheel_mass": self.wheel_mass,
             "contact_rebuilds": self.contact.rebuilds,
             "seconds_per_simulated_second": wall / max(float(t[-1]), 1e-12),
-            **{f"t_{k}": v for k, v in self.phase_times.items()},
+            "t_released": loop["t_release"], "t_spin_up": loop["t_spin"], "t_wind_up": loop["t_windup"],
+            "t_hold": loop["t_hold"], "wind_up_converged": bool(loop["windup_converged"]),
+            "patch_shifts": int(self.patch.shifts) if self.patch is not None else 0,
         }
         return TestbedResult(series=rows, summary=summary, spec=s, wheel=self.wheel, bed_summary=self.bed.summary(),
-                             info=info, final_particles=particles, final_wheel_nodes=self.structure.positions(),
-                             mesh=self.mesh)
+                             info=info, final_particles=particles, final_wheel_nodes=nodes,
+                             final_deformation=self.deformation(nodes), mesh=self.mesh)
+
+    def deformation(self, nodes: np.ndarray | None = None) -> np.ndarray:
+        """The wheel's deformation [m] (N, 3): node positions less the wheel's best-fit rigid motion from its
+        start pose, the fit weighted by the nodes' lumped masses (:func:`.kinematics.deformation`)."""
+        nodes = self.structure.positions() if nodes is None else nodes
+        weights = np.maximum(self.structure.mass, 0.0)
+        weights[self.structure.hub_nodes] += self.wheel.hub_mass / max(len(self.structure.hub_nodes), 1)
+        return deformation(nodes, self.mesh.nodes, weights)
+
+
+class _ProgressBar:
+    """The run's progress on the terminal (rich): phase, time, forces and the tread's slip."""
+
+    def __init__(self, bench: Testbed) -> None:
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self.bench = bench
+        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                            TimeElapsedColumn(), transient=True)
+        self.bar.start()
+        self.task = self.bar.add_task("testbed", total=None)
+
+    def update(self) -> None:
+        b, rows = self.bench, self.bench.rows
+        loop, s = b._loop, b.spec
+        total = completed = None
+        if math.isfinite(loop["t_spin"]):
+            end = loop["t_spin"] + s.spin_up_time + s.drive_time
+            total, completed = 1000, int(1000 * min(1.0, (b.scene.time - loop["t_release"]) / (end - loop["t_release"])))
+        text = (f"{loop['phase']:8s} t = {b.scene.time:.3f} s  DP {rows['drawbar_pull'][-1]:8.1f} N  "
+                f"Fz {rows['vertical_force'][-1]:8.1f} N  T {rows['torque'][-1]:7.1f} N m  "
+                f"sinkage {1e3 * rows['sinkage'][-1]:6.1f} mm")
+        if loop["phase"] in ("wind-up", "drive"):
+            n = max(1, int(b.pitch / s.angular_velocity / (b.steps_per_sample * b.dt)))
+            omega_t = float(np.mean(rows["tread_omega"][-n:]))
+            slip = 1.0 - b.travel_speed * math.cos(math.radians(s.slip_angle)) / (b.wheel.radius * omega_t) \
+                if omega_t > 0 else math.nan
+            text += f"  tread slip {slip:.3f} (commanded {s.slip:g})"
+        self.bar.update(self.task, total=total, completed=completed, description=text)
+
+    def stop(self) -> None:
+        self.bar.stop()

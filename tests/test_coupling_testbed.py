@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from wheelsoil.coupling.surface import ContactSurface
-from wheelsoil.coupling.testbed import Testbed, TestbedSpec, detect_steady_state
+from wheelsoil.coupling.testbed import Testbed, TestbedSpec
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.flexwheel.material import SEED004_WHEEL
@@ -20,7 +20,7 @@ MINI_WHEEL = WheelGeometry(
 )
 MINI_BED = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015)
 MINI_RUN = TestbedSpec(slip=0.3, slip_angle=10.0, load=80.0, angular_velocity=2.0, settle_time=0.05,
-                       drive_time=0.3, steady_window=0.08)
+                       drive_time=0.3, average_time=0.1, stop_when_steady=False)
 
 
 @pytest.fixture(scope="module")
@@ -40,9 +40,12 @@ def test_steady_state_force_balance_and_signs(steering_run):
     w = MINI_RUN.load
     # the axle is free vertically under W: in steady state the soil carries W
     assert s["vertical_force"]["mean"] == pytest.approx(w, rel=0.15)
-    # the rig commands slip and slip angle exactly
+    # the rig commands slip and slip angle exactly (the hub's); the tread's are measured and recorded beside them
     assert s["slip"]["mean"] == pytest.approx(0.3, abs=1e-9)
     assert s["slip_angle"]["mean"] == pytest.approx(10.0, abs=1e-9)
+    assert s["commanded_slip"] == 0.3 and np.isfinite(s["tread_slip"]["mean"])
+    # a 0.3 s drive of a winding-up wheel is not a steady state, and the summary says why
+    assert not s["steady"] and s["reasons"]
     # a driven wheel at 30 % slip pulls and needs torque; the soil resists the lateral slip (v_y > 0)
     assert s["drawbar_pull"]["mean"] > 0.0
     assert s["torque"]["mean"] > 0.0
@@ -80,15 +83,14 @@ def test_render_of_the_last_state_shows_wheel_and_soil(steering_run, tmp_path):
     assert coloured.mean() > 0.05
 
 
-def test_steady_state_detection_finds_the_plateau():
-    t = np.linspace(0, 2, 401)
-    rng = np.random.default_rng(0)
-    y = 100 * (1 - np.exp(-t / 0.2)) + rng.normal(0, 2, t.size)
-    k, steady = detect_steady_state(t, {"y": y}, start=0.0, window=0.2, tolerance=0.05, scales={"y": 5.0})
-    assert steady and 0.3 < t[k] < 1.0
-    ramp = 100 * t
-    k, steady = detect_steady_state(t, {"y": ramp}, start=0.0, window=0.2, tolerance=0.05, scales={"y": 5.0})
-    assert not steady
+def test_rigid_wheel_tread_turns_with_the_hub(mini_bed):
+    """A rigid wheel cannot wind up: its tread slip and slip angle are the commanded ones, to round-off."""
+    bench = Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, rigid=True, drive_time=0.15, average_time=0.05))
+    result = bench.run()
+    drive = result.series["t"] > result.info["t_wind_up"] + 0.01
+    assert np.abs(result.series["wind_up"]).max() < 1e-9
+    assert np.allclose(result.series["tread_slip"][drive], 0.3, atol=1e-6)
+    assert np.allclose(result.series["tread_slip_angle"][drive], 10.0, atol=1e-6)
 
 
 @pytest.mark.parametrize(
@@ -103,6 +105,10 @@ def test_steady_state_detection_finds_the_plateau():
         (dict(angular_velocity=0.0), "angular_velocity"),
         (dict(drive_time=float("nan")), "drive_time"),
         (dict(axle_damping=-1.0), "axle_damping"),
+        (dict(average_time=0.5), "average_time"),
+        (dict(windup="fast"), "windup"),
+        (dict(max_wind_up=2.0), "max_wind_up"),
+        (dict(slip_tolerance=0.0), "slip_tolerance"),
     ],
 )
 def test_bad_rig_settings_name_the_key_value_and_range(change, key):
@@ -115,7 +121,7 @@ def test_wheel_wider_than_the_bin_short_bin_and_missing_bed_are_refused(mini_bed
         Testbed(mini_bed, replace(MINI_WHEEL, width=0.3), MINI_RUN)
     with pytest.raises(WheelsoilInputError, match="does not fit the bed width"):
         Testbed(mini_bed, replace(MINI_WHEEL, width=0.2), replace(MINI_RUN, slip_angle=30.0))
-    with pytest.raises(WheelsoilInputError, match="too short"):
+    with pytest.raises(WheelsoilInputError, match=r"too short for test.drive_time = 5.0 s.*periodic bed"):
         Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, drive_time=5.0))
     with pytest.raises(WheelsoilInputError, match="does not exist"):
         Testbed(tmp_path / "missing.h5", MINI_WHEEL, MINI_RUN)
@@ -134,7 +140,8 @@ def test_drawbar_pull_and_torque_rise_with_slip(mini_bed):
     """Straight driving at slip 0.1 and 0.6: more slip mobilises more shear, so DP and torque rise
     (seed 004 Figs. 7--8; Wong--Reece/Janosi shear grows with slip). The difference must exceed three
     combined standard errors of the steady means."""
-    runs = {i: Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, slip=i, slip_angle=0.0)).run() for i in (0.1, 0.6)}
+    runs = {i: Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, slip=i, slip_angle=0.0, windup="none")).run()
+            for i in (0.1, 0.6)}
     for q in ("drawbar_pull", "torque"):
         (lo, e_lo), (hi, e_hi) = (_mean_and_error(runs[i], q) for i in (0.1, 0.6))
         assert hi - lo > 3.0 * np.hypot(e_lo, e_hi), (q, lo, e_lo, hi, e_hi)

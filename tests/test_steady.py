@@ -1,0 +1,101 @@
+"""The steady-state detector on synthetic runs with known answers: windows of whole tread pitches, means and
+standard errors against the truth, and refusals (drifting forces, a tread that still winds up, a tread slip
+away from the commanded one) that name the quantity and the amount. Several seeds each."""
+
+import math
+
+import numpy as np
+import pytest
+
+from wheelsoil.coupling.steady import detect_steady_state, pitch_boundaries
+
+DT = 0.005  # sample interval [s]
+OMEGA = 1.0  # tread spin [rad/s]
+R = 0.6  # wheel radius [m]
+PITCH = math.radians(15.0)  # grouser pitch
+SLIP = 0.3
+
+
+def synthetic_run(seed, *, t_end=4.0, tau=0.4, drift=0.0, slip_drift=0.0, slip_offset=0.0):
+    """A run that settles with time constant tau onto a plateau, with a component at the grouser frequency and
+    red noise; optional linear drift of the force and of the tread slip."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(1, int(t_end / DT) + 1) * DT
+    noise = np.zeros(t.size)
+    for k in range(1, t.size):  # AR(1), correlation time ~ 25 ms
+        noise[k] = 0.8 * noise[k - 1] + rng.normal(0.0, 30.0)
+    grouser = 50.0 * np.sin(2 * np.pi * OMEGA * t / PITCH)
+    force = 1000.0 * (1.0 - np.exp(-t / tau)) + grouser + noise + drift * t
+    spin = np.full(t.size, OMEGA)
+    slip = SLIP + slip_offset + slip_drift * (t - t_end / 2)
+    speed = (1.0 - slip) * R * spin  # travel speed that gives this tread slip
+    angle = np.cumsum(spin * DT)
+    return t, {"drawbar_pull": force}, angle, speed
+
+
+def detect(t, series, angle, speed, **kw):
+    args = dict(tread_angle=angle, travel_speed=speed, radius=R, pitch=PITCH, start=0.0, min_pitches=4,
+                tolerance=0.1, floors={"drawbar_pull": 150.0}, slip_target=SLIP, slip_tolerance=0.03,
+                sample_interval=DT)
+    args.update(kw)
+    return detect_steady_state(t, series, **args)
+
+
+def test_pitch_boundaries_span_whole_pitches():
+    t = np.arange(1, 801) * DT
+    angle = OMEGA * t
+    bounds = pitch_boundaries(angle, len(t), PITCH, 1)
+    turned = [angle[b0 - 1] - angle[b1 - 1] for b0, b1 in zip(bounds[:-1], bounds[1:])]
+    assert np.allclose(turned, PITCH, atol=OMEGA * DT)  # each within one sample of a pitch
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4, 5])
+def test_a_settling_run_is_steady_after_its_transient_and_the_mean_is_within_its_error(seed):
+    t, series, angle, speed = synthetic_run(seed)
+    state = detect(t, series, angle, speed)
+    assert state.steady, state.reasons
+    assert state.window[0] >= 1.0  # the transient (tau = 0.4 s) is out of the window
+    # whole pitches: the window spans a whole number of pitches of the tread angle
+    turned = angle[state.k1 - 1] - angle[state.k0 - 1]
+    assert turned / PITCH == pytest.approx(state.pitches, abs=0.05)
+    st = state.stats["drawbar_pull"]
+    truth = 1000.0 * np.mean(1.0 - np.exp(-t[state.k0:state.k1] / 0.4))
+    assert abs(st["mean"] - truth) < 4.0 * st["sem"] + 1.0, (st, truth)
+    assert state.tread_slip == pytest.approx(SLIP, abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_drifting_force_is_not_steady_and_the_reason_names_it(seed):
+    t, series, angle, speed = synthetic_run(seed, drift=400.0)  # +400 N/s: +30 % over a second, as the issue saw
+    state = detect(t, series, angle, speed)
+    assert not state.steady
+    assert any(r.startswith("drawbar_pull drifts by +") for r in state.reasons), state.reasons
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_tread_still_winding_up_is_not_steady(seed):
+    t, series, angle, speed = synthetic_run(seed, slip_drift=0.05)  # tread slip rising 0.05 per second
+    state = detect(t, series, angle, speed)
+    assert not state.steady
+    assert any("still winding up" in r for r in state.reasons), state.reasons
+
+
+@pytest.mark.parametrize("offset", [-0.08, 0.05])
+def test_a_tread_slip_away_from_the_commanded_slip_is_not_steady(offset):
+    t, series, angle, speed = synthetic_run(7, slip_offset=offset)
+    state = detect(t, series, angle, speed)
+    assert not state.steady
+    assert state.tread_slip == pytest.approx(SLIP + offset, abs=1e-9)
+    assert any("differs from the commanded" in r for r in state.reasons), state.reasons
+
+
+def test_too_short_a_drive_says_so():
+    t, series, angle, speed = synthetic_run(1, t_end=0.2)
+    state = detect(t, series, angle, speed)
+    assert not state.steady and "has not yet turned" in state.reasons[0]
+
+
+def test_windows_are_whole_periods_when_spokes_and_grousers_differ():
+    t, series, angle, speed = synthetic_run(3)
+    state = detect(t, series, angle, speed, period_pitches=2)
+    assert state.steady and state.pitches % 2 == 0
