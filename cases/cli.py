@@ -39,6 +39,11 @@ sweep slip and steering angle (local processes, or --scheduler for a dask cluste
 
     wheelsoil batch mini-slip
 
+show how far a case's numbers are from a finer or larger scale (particle size, bed depth and width,
+DEM time step, wheel mesh; report in convergence.md):
+
+    wheelsoil convergence mini-1g-steer
+
 hold the semi-empirical model against measured data and name what it misses:
 
     wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --holdout slip_angle=60
@@ -175,6 +180,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
     p.set_defaults(func=cmd_batch)
 
+    p = sub.add_parser("convergence", help="convergence study of a case: particle size, bed depth and width, time "
+                                           "step, wheel mesh; report of the changes",
+                       description="Run a case at its reference scale and at refined levels of each factor "
+                                   "(particle size x 1, 0.8, 0.64; bed depth and width x 1, 2; DEM time step and wheel "
+                                   "element size x 1, 0.5 by default), as a sweep in --out (finished cases are kept), "
+                                   "and write convergence.md, convergence.csv, convergence.json and convergence.png: "
+                                   "every reported quantity's change between neighbouring levels with its standard "
+                                   "error, and the coarsest scale of each factor at which all change by less than "
+                                   "--threshold (cases/convergence.py documents the method).")
+    p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name")
+    _add_set_option(p)
+    for factor, levels in (("particle-size", "1,0.8,0.64"), ("depth", "1,2"), ("width", "1,2"),
+                           ("time-step", "1,0.5"), ("mesh", "1,0.5")):
+        p.add_argument(f"--{factor}-levels", default=None, metavar="SCALES",
+                       help=f"scales of {factor.replace('-', ' ')}, reference 1 first (default {levels})")
+    p.add_argument("--factors", default="particle_size,depth,width,time_step,mesh",
+                   help="factors to study, comma-separated (default: all five)")
+    p.add_argument("--threshold", type=float, default=0.10, help="largest relative change called converged "
+                                                                 "(default 0.10)")
+    p.add_argument("--out", type=Path, default=None, help="study folder (default wheelsoil-output/convergence/<case>)")
+    p.add_argument("--workers", type=int, default=1, help="cases run at once (default 1: a coupled run uses both "
+                                                          "cores of a small machine)")
+    p.add_argument("--timeout", type=float, default=None, help="give up a case after this many seconds")
+    p.add_argument("--report-only", action="store_true", help="only rewrite the report from the finished cases")
+    p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
+    p.set_defaults(func=cmd_convergence)
+
     p = sub.add_parser("prepare-bed", help="fill, settle and level a soil bin (a case's, or from options); write it",
                        description="Fill a bin with polydisperse spheres, settle under gravity until the kinetic "
                                    "energy per particle is below the threshold, level at the target depth, and "
@@ -224,14 +256,21 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Mesh a preset wheel (lunar-rover: seed 004; exomars: seeds 000/001), write the "
                                    "mesh as VTU, and measure its radial stiffness: point-load stiffness at angles "
                                    "over one spoke pitch, and the load-deflection curve against a rigid flat plate "
-                                   "over the spoke and midway between spokes. Writes mesh.vtu, load_test.csv, "
-                                   "load_test.png and summary.json to --out.")
+                                   "over the spoke and midway between spokes; and its torsional stiffness (the hub's "
+                                   "torque against its twist ahead of the tread, tread clamped and tread loaded, linear "
+                                   "and corotational in both directions: how far the wheel winds up under a driving "
+                                   "torque). Writes mesh.vtu, load_test.csv, load_test.png, torsion_test.csv, "
+                                   "torsion_test.png and summary.json to --out.")
     p.add_argument("preset", help="wheel preset: lunar-rover or exomars")
     p.add_argument("--element-size", type=float, default=None, help="target element edge [m] (default: the preset's)")
     p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/wheel-<preset>)")
     p.add_argument("--points", type=int, default=6, help="load steps of the plate curve (default 6)")
     p.add_argument("--max-load-factor", type=float, default=1.5,
                    help="largest plate load as a multiple of the preset's nominal load (default 1.5)")
+    p.add_argument("--torsion", choices=("corotational", "linear", "none"), default="corotational",
+                   help="torsion load test: linear only, or also the corotational curves (default; minutes on a fine mesh)")
+    p.add_argument("--max-twist", type=float, default=10.0,
+                   help="largest twist of the corotational torsion curves [deg] (default 10)")
     p.set_defaults(func=cmd_wheel)
 
     p = sub.add_parser("validate", help="hold the semi-empirical model against measured data; name what it misses",
@@ -324,6 +363,28 @@ def _load_case_from_args(args):
     return load_case(args.case, overrides)
 
 
+def summary_lines(s: dict) -> list[str]:
+    """The steady-state summary of a run as terminal lines (rich markup): the verdict, the window, the means
+    with their standard errors, and the tread's slip beside the commanded one."""
+    span = f"t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s"
+    if s["steady"]:
+        head = f"[green]steady[/] over {span} ({s.get('pitches', 0)} pitches of {s.get('pitch_deg', 0):.1f} deg):"
+    else:
+        head = f"[yellow]NOT steady[/]: averaged the last window, {span}, for information only:"
+    lines = [head]
+    for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
+        st = s[q]
+        sem = st.get("sem", float("nan"))
+        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}, fluctuation {st['std']:.3g})")
+    if "tread_slip" in s:
+        lines.append(f"  {'tread slip':16s} {s['tread_slip']['mean']:10.4f}      (commanded {s.get('commanded_slip', float('nan')):g}; "
+                     f"tread slip angle {s['tread_slip_angle']['mean']:.2f} deg, commanded "
+                     f"{s.get('commanded_slip_angle', float('nan')):g}; wind-up {s['wind_up']['mean']:.3f} rad)")
+    for reason in s.get("reasons", []):
+        lines.append(f"  [yellow]not steady:[/] {reason}")
+    return lines
+
+
 def cmd_run(args) -> int:
     from .run import run_case
 
@@ -333,10 +394,8 @@ def cmd_run(args) -> int:
     outcome = run_case(case, out, arch=args.arch, resume=args.resume, restart=args.restart,
                        progress=console.is_terminal, console=console)
     s = outcome.testbed_result.summary
-    console.print(("steady state" if s["steady"] else "[yellow]no steady state detected; averaged the last half[/]")
-                  + f" over t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s:")
-    for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
-        console.print(f"  {q:15s} {s[q]['mean']:10.4g} +- {s[q]['std']:.3g} {s[q]['units']}")
+    for line in summary_lines(s):
+        console.print(line)
     info = outcome.testbed_result.info
     console.print(f"{info['wall_seconds']:.0f} s wall for {info['simulated_seconds']:.2f} s simulated; "
                   f"wrote {outcome.result_path} (+ .xdmf for ParaView), series.csv, summary.json, case.toml, "
@@ -369,6 +428,37 @@ def cmd_batch(args) -> int:
     for key, v in failed.items():
         console.print(f"  [red]failed[/] {key}: {v.get('error')} (log: {sweep.out / 'cases' / key / 'run.log'})")
     return EXIT_SWEEP_FAILED if failed else EXIT_OK
+
+
+def cmd_convergence(args) -> int:
+    from .convergence import DEFAULT_LEVELS, make_study, parse_levels, run_study, write_report
+    from .schema import load_case
+
+    console = _console()
+    case = load_case(args.case, list(args.set or []))
+    factors = [f.strip() for f in args.factors.split(",") if f.strip()]
+    unknown = [f for f in factors if f not in DEFAULT_LEVELS]
+    if unknown or not factors:
+        raise _InputError(f"--factors {args.factors!r}: choose from {', '.join(DEFAULT_LEVELS)}")
+    if args.workers < 1:
+        raise _InputError(f"--workers {args.workers} must be >= 1")
+    if args.timeout is not None and not args.timeout > 0:
+        raise _InputError(f"--timeout {args.timeout} must be > 0 seconds")
+    levels = {f: parse_levels(getattr(args, f"{f}_levels"), f) for f in factors}
+    out = args.out or Path("wheelsoil-output") / "convergence" / case.name
+    study = make_study(case, out, levels, args.threshold)
+    if args.report_only:
+        paths = write_report(study)
+    else:
+        console.print(f"convergence study of {case.name}: {len(study.cases())} cases "
+                      f"(+ {sum(lv.case is None for lvs in study.levels.values() for lv in lvs)} time-step levels after the reference) "
+                      f"in {out}")
+        run_study(study, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
+                  console=console)
+        paths = [out / n for n in ("convergence.md", "convergence.csv", "convergence.json", "convergence.png")]
+    console.print((out / "convergence.md").read_text() if (out / "convergence.md").is_file() else "")
+    console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")
+    return EXIT_OK
 
 
 def cmd_case(args) -> int:
@@ -452,6 +542,8 @@ def cmd_wheel(args) -> int:
         "plate_secant_stiffness_at_nominal_N_per_m": nominal,
         "provenance": provenance(),
     }
+    if args.torsion != "none":
+        summary["torsion"] = _torsion_tests(geometry, mesh, args, out, console)
     with atomic_output(out / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2))
     _plot_load_curves(curves, geometry, out / "load_test.png")
@@ -460,8 +552,89 @@ def cmd_wheel(args) -> int:
                   + f"; mean {np.mean(point) / 1e3:.2f} kN/m")
     for key, k in nominal.items():
         console.print(f"plate secant stiffness at the nominal {geometry.nominal_load:g} N, wheel at {key} deg: {k / 1e3:.2f} kN/m")
-    console.print(f"wrote {out / 'load_test.csv'}, {out / 'load_test.png'}, {out / 'summary.json'}")
+    torsion = f", {out / 'torsion_test.csv'}, {out / 'torsion_test.png'}" if args.torsion != "none" else ""
+    console.print(f"wrote {out / 'load_test.csv'}, {out / 'load_test.png'}{torsion}, {out / 'summary.json'}")
     return EXIT_OK
+
+
+def _torsion_tests(geometry, mesh, args, out, console) -> dict:
+    """The torsion load tests of ``wheelsoil wheel``: torsion_test.csv, torsion_test.png and the summary entries."""
+    import math
+
+    import numpy as np
+
+    from wheelsoil.flexwheel.torsion import torsion_test, tread_nodes
+    from wheelsoil.provenance import atomic_output
+
+    if not (0 < args.max_twist <= 45):
+        raise _InputError(f"--max-twist={args.max_twist} deg must lie in (0, 45]")
+    linear = {hold: torsion_test(geometry, method="linear", hold=hold) for hold in ("tread", "free")}
+    curves = list(linear.values())
+    twists = np.radians([-args.max_twist, -args.max_twist / 2, -1.0, 1.0, args.max_twist / 2, args.max_twist])
+    if args.torsion == "corotational":
+        with _progress(console) as bar:
+            task = bar.add_task("torsion, tread clamped", total=len(twists))
+            curves.append(torsion_test(geometry, twists, method="corotational", hold="tread",
+                                       progress=lambda k, n: bar.update(task, completed=k)))
+            task = bar.add_task("torsion, torque on the tread", total=len(twists))
+            curves.append(torsion_test(geometry, method="corotational", hold="free",
+                                       torques=linear["free"].stiffness * twists,
+                                       progress=lambda k, n: bar.update(task, completed=k)))
+    rows = ["hold,method,twist_deg,torque_N_m,secant_stiffness_N_m_per_rad"]
+    for c in curves:
+        rows += [f"{c.hold},{c.method},{math.degrees(t):.6g},{q:.6g},{q / t:.6g}" for t, q in zip(c.twist, c.torque)]
+    with atomic_output(out / "torsion_test.csv") as tmp:
+        tmp.write_text("\n".join(rows) + "\n")
+    # the torsion mode of the tread on its spokes, hub held: f = sqrt(k_t / I) / 2 pi, I the tread's and grousers'
+    # inertia about the axle (their nodes beyond the spokes' reach)
+    mass, _ = mesh.lumped_mass()
+    outer = np.flatnonzero(np.hypot(mesh.nodes[:, 0], mesh.nodes[:, 2]) >= geometry.tread_mid_radius - 1e-9)
+    inertia = float(np.sum(mass[outer] * (mesh.nodes[outer, 0] ** 2 + mesh.nodes[outer, 2] ** 2)))
+    frequency = math.sqrt(linear["free"].stiffness / inertia) / (2 * math.pi)
+    result = {"linear_tread_clamped_N_m_per_rad": linear["tread"].stiffness,
+              "linear_torque_on_tread_N_m_per_rad": linear["free"].stiffness,
+              "tread_inertia_kg_m2": inertia, "torsion_mode_hub_held_Hz": frequency}
+    for c in curves[2:]:
+        result[f"corotational_{c.hold}"] = {"twist_deg": np.degrees(c.twist).tolist(), "torque_N_m": c.torque.tolist()}
+    _plot_torsion(curves, out / "torsion_test.png", geometry.name)
+    console.print(f"torsional stiffness (linear): {linear['tread'].stiffness / 1e3:.2f} kN m/rad with the tread clamped, "
+                  f"{linear['free'].stiffness / 1e3:.2f} kN m/rad with the torque on the tread; torsion mode of the "
+                  f"tread (hub held) {frequency:.2f} Hz")
+    for c in curves[2:]:
+        k = c.secant_stiffness()
+        console.print(f"  corotational, {'tread clamped' if c.hold == 'tread' else 'torque on the tread'}: "
+                      + ", ".join(f"{math.degrees(t):+.1f} deg: {q / 1e3:.2f}" for t, q in zip(c.twist, k)) + " kN m/rad")
+    return result
+
+
+def _plot_torsion(curves, path, name):
+    import matplotlib
+    import numpy as np
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from wheelsoil.provenance import atomic_output
+
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    span = max(abs(float(np.max(np.abs(c.twist)))) for c in curves)
+    for c in curves:
+        label = f"{'tread clamped' if c.hold == 'tread' else 'torque on the tread'}, {c.method}"
+        if c.method == "linear":
+            tw = np.linspace(-span, span, 3)
+            ax.plot(np.degrees(tw), c.stiffness * tw, "--", lw=1, label=label)
+        else:
+            ax.plot(np.degrees(c.twist), c.torque, "o-", label=label)
+    ax.axhline(0, color="0.7", lw=0.5)
+    ax.axvline(0, color="0.7", lw=0.5)
+    ax.set_xlabel("twist: hub ahead of the tread [deg] (+: drive)")
+    ax.set_ylabel("torque on the hub [N m]")
+    ax.set_title(f"{name}: torsion load test")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
 
 
 def _progress(console):

@@ -17,7 +17,8 @@ def _pyplot():
 
 
 def plot_series(result, path: str | Path, title: str) -> Path:
-    """Forces, torque and sinkage of one run against time, the averaging window shaded.
+    """Forces, torque, sinkage and the slip the tread saw (with the wheel's wind-up) against time, the
+    averaging window shaded.
 
     ``result``: a :class:`~wheelsoil.coupling.testbed.TestbedResult` or :class:`~wheelsoil.cases.results.Result`
     (anything with ``series`` and ``summary``; the load line is drawn from the ``load`` series).
@@ -26,7 +27,7 @@ def plot_series(result, path: str | Path, title: str) -> Path:
 
     plt = _pyplot()
     s, t = result.series, result.series["t"]
-    fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+    fig, axes = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
     for name in ("drawbar_pull", "lateral_force", "vertical_force"):
         axes[0].plot(t, s[name], label=name.replace("_", " "))
     load = float(np.max(s["load"])) if len(s["load"]) else 0.0
@@ -39,7 +40,16 @@ def plot_series(result, path: str | Path, title: str) -> Path:
     axes[2].plot(t, 1e3 * s["tread_sinkage"], color="C5", label="tread")
     axes[2].set_ylabel("sinkage [mm]")
     axes[2].legend(fontsize=8)
-    axes[2].set_xlabel("time [s]")
+    if "tread_slip" in s:
+        axes[3].plot(t, s["slip"], color="0.4", ls="--", label="commanded (hub)")
+        axes[3].plot(t, s["tread_slip"], color="C0", lw=0.8, label="seen by the tread")
+        axes[3].set_ylim(-0.2, 1.0)
+        axes[3].set_ylabel("slip i")
+        twin = axes[3].twinx()
+        twin.plot(t, np.degrees(s["wind_up"]), color="C1", lw=0.8, label="wind-up")
+        twin.set_ylabel("wind-up [deg]", color="C1")
+        axes[3].legend(fontsize=8, loc="upper left")
+    axes[3].set_xlabel("time [s]")
     t0, t1 = result.summary["window"]
     for ax in axes:
         ax.axvspan(t0, t1, color="0.9", zorder=0)

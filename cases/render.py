@@ -59,16 +59,20 @@ def render_image(
     title: str | None = None,
     surface: tuple[np.ndarray, np.ndarray] | None = None,
     surface_scalars: np.ndarray | None = None,
-    surface_scalar_name: str = "wheel deflection [mm]",
+    surface_scalar_name: str = "wheel deformation [mm]",
     clim: tuple[float, float] | None = None,
     surface_clim: tuple[float, float] | None = None,
+    arrows: list | None = None,
+    scale_bar: bool = True,
 ) -> np.ndarray:
     """Spheres (coloured by ``scalars``, default height) as an (H, W, 3) uint8 image.
 
-    ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline. ``camera`` is one of
-    :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a triangulated
-    surface (the wheel): steel grey, or coloured by the nodal ``surface_scalars``. ``clim`` and
-    ``surface_clim`` fix the colour ranges (for animations).
+    ``box`` = ((xmin, ymin, zmin), (xmax, ymax, zmax)) draws the bin outline and, with ``scale_bar``, a
+    ruler in metres along its front bottom edge; an axes triad (X, Y, Z) sits in the lower left corner.
+    ``camera`` is one of :data:`CAMERA_PRESETS`. ``surface`` = (nodes (N, 3), triangles (T, 3)) adds a
+    triangulated surface (the wheel): steel grey, or coloured by the nodal ``surface_scalars``. ``clim`` and
+    ``surface_clim`` fix the colour ranges (for animations). ``arrows``: (origin (3,) [m], vector (3,) [m],
+    colour, label) tuples drawn as 3-D arrows with their label at the tip (heading and travel, say).
     """
     import pyvista as pv
 
@@ -105,6 +109,20 @@ def render_image(
         lo, hi = np.asarray(box[0], float), np.asarray(box[1], float)
         plotter.add_mesh(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).outline(), color="black",
                          line_width=2)
+    for origin, vector, colour, label in arrows or ():
+        origin, vector = np.asarray(origin, float), np.asarray(vector, float)
+        length = float(np.linalg.norm(vector))
+        if length <= 0:
+            continue
+        plotter.add_mesh(pv.Arrow(start=origin, direction=vector / length, scale=length, tip_length=0.25,
+                                  tip_radius=0.08, shaft_radius=0.03), color=colour)
+        plotter.add_point_labels(pv.PolyData((origin + 1.05 * vector)[None, :]), [label], font_size=14,
+                                 text_color=colour, shape=None, show_points=False, always_visible=True)
+    if box is not None and scale_bar:
+        lo, hi = np.asarray(box[0], float), np.asarray(box[1], float)
+        plotter.add_ruler((lo[0], lo[1], lo[2]), (hi[0], lo[1], lo[2]), title="m", font_size_factor=0.5,
+                          label_color="black", tick_color="black")
+    plotter.add_axes(color="black", line_width=2, labels_off=False)
     if title:
         plotter.add_text(title, font_size=10, color="black")
     direction, up = CAMERA_PRESETS[camera]
@@ -126,19 +144,38 @@ def render_bed(bed, path: str | Path, **kwargs) -> Path:
     )
 
 
+def motion_arrows(wheel_nodes: np.ndarray, slip_angle: float) -> list:
+    """Arrows (for :func:`render_image`) from above the wheel: its heading (blue; the wheel is yawed by
+    -beta, :mod:`wheelsoil.coupling.testbed`) and the carriage's travel along +X (red), 0.6 wheel
+    diameters long."""
+    size = float(np.ptp(wheel_nodes[:, 0]))
+    origin = 0.5 * (wheel_nodes.min(axis=0) + wheel_nodes.max(axis=0)) + np.array([0.0, 0.0, 0.75 * size])
+    b = np.radians(slip_angle)
+    return [(origin, 0.6 * size * np.array([np.cos(b), -np.sin(b), 0.0]), "#1f5fbf", "heading"),
+            (origin, 0.6 * size * np.array([1.0, 0.0, 0.0]), "#c0392b", "travel")]
+
+
 def render_testbed(result, path: str | Path, **kwargs) -> Path:
-    """Render the end of a testbed run: the wheel over the particles, coloured by speed [m/s].
+    """Render the end of a testbed run: the wheel (coloured by its deformation when the result holds it) over
+    the particles (coloured by speed [m/s]), heading and travel arrows, slip and steering in the title.
 
     ``result`` is a :class:`~wheelsoil.coupling.testbed.TestbedResult`.
     """
     p = result.final_particles
     speed = np.linalg.norm(p["velocity"], axis=1)
     lo, hi = p["position"].min(axis=0) - p["radius"].max(), p["position"].max(axis=0) + p["radius"].max()
-    hi[2] = max(hi[2], float(result.final_wheel_nodes[:, 2].max()))
-    kwargs.setdefault("title", f"{result.bed_summary.split(':')[0]}; t = {result.info['simulated_seconds']:.2f} s")
+    nodes = result.final_wheel_nodes
+    hi[2] = max(hi[2], float(nodes[:, 2].max()))
+    spec = result.spec
+    tread = result.summary.get("tread_slip", {}).get("mean", float("nan"))
+    kwargs.setdefault("title", f"{result.bed_summary.split(':')[0]}; t = {result.info['simulated_seconds']:.2f} s, "
+                               f"slip {spec.slip:.2f} commanded / {tread:.3f} at the tread (window mean), "
+                               f"steering {spec.slip_angle:g} deg")
+    kwargs.setdefault("arrows", motion_arrows(nodes, spec.slip_angle))
+    if result.final_deformation is not None:
+        kwargs.setdefault("surface_scalars", 1e3 * np.linalg.norm(result.final_deformation, axis=1))
     return render_particles(p["position"], p["radius"], path, scalars=speed, scalar_name="speed [m/s]",
-                            box=(lo, hi), surface=(result.final_wheel_nodes, result.mesh.triangles),
-                            **kwargs)
+                            box=(lo, hi), surface=(nodes, result.mesh.triangles), **kwargs)
 
 
 PARTICLE_COLORS = {"speed": "speed [m/s]", "height": "height [m]"}
@@ -165,13 +202,37 @@ def result_box(result) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+def _result_kinematics(result) -> tuple[float, float]:
+    """(commanded slip, steering angle beta [deg]) of a result's case."""
+    test = result.case.test
+    return float(test.slip), float(test.slip_angle)
+
+
+def frame_annotations(result, frame: dict) -> tuple[str, list]:
+    """The title and arrows of a frame: commanded slip and steering angle, the slip the tread saw at that
+    time (the ``tread_slip`` series, averaged over the last tenth of a second before the frame), and arrows
+    for the wheel's heading (blue) and the carriage's travel (+X, red) from above the hub."""
+    slip, beta = _result_kinematics(result)
+    t = float(frame["t"])
+    series = result.series
+    recent = (series["t"] <= t) & (series["t"] > t - 0.1)
+    tread = f"{float(np.mean(series['tread_slip'][recent])):.3f}" if recent.any() else "n/a"
+    title = (f"{result.attrs.get('case_name', '')}: t = {t:.2f} s, slip {slip:.2f} commanded / {tread} at the "
+             f"tread, steering {beta:g} deg")
+    return title, motion_arrows(frame["wheel_nodes"], beta)
+
+
 def render_result_frame(result, path: str | Path, *, frame: int = -1, color: str = "speed",
                         wheel_color: str | None = "deflection", **kwargs) -> Path:
     """Render frame ``frame`` of a :class:`~wheelsoil.cases.results.Result` to a PNG: particles coloured by
-    speed (or height), the wheel by the magnitude of its deflection (displacement less the hub's rigid motion)."""
+    speed (or height), the wheel by the magnitude of its deformation (displacement less the wheel's
+    best-fit rigid motion, so neither the hub's travel nor the tread's rotation shows), arrows for heading and
+    travel, the commanded and tread slip and the steering angle in the title (:func:`frame_annotations`)."""
     f = result.frame(frame)
     scalars, wheel = _frame_view(f, color, wheel_color)
-    kwargs.setdefault("title", f"{result.attrs.get('case_name', '')}: t = {f['t']:.3f} s")
+    title, arrows = frame_annotations(result, f)
+    kwargs.setdefault("title", title)
+    kwargs.setdefault("arrows", arrows)
     kwargs.setdefault("box", result_box(result))
     return render_particles(f["position"], f["radius"], path, scalars=scalars, scalar_name=PARTICLE_COLORS[color],
                             surface=(f["wheel_nodes"], f["triangles"]), surface_scalars=wheel, **kwargs)
@@ -205,10 +266,11 @@ def render_animation(result, path: str | Path, *, fps: float = 10.0, color: str 
         target = tmp.with_name(tmp.name + path.suffix.lower())  # the writers pick the format from the suffix
         with imageio.get_writer(target, format=fmt, mode="I", **options) as writer:
             for k, (f, (scalars, wheel)) in enumerate(zip(frames, views)):
+                title, arrows = frame_annotations(result, f)
                 image = render_image(f["position"], f["radius"], scalars=scalars, scalar_name=PARTICLE_COLORS[color],
                                      box=box, camera=camera, size=size, surface=(f["wheel_nodes"], f["triangles"]),
-                                     surface_scalars=wheel, clim=clim, surface_clim=surface_clim,
-                                     title=f"{result.attrs.get('case_name', '')}: t = {f['t']:.3f} s")
+                                     surface_scalars=wheel, clim=clim, surface_clim=surface_clim, title=title,
+                                     arrows=arrows)
                 writer.append_data(image)
                 if progress is not None:
                     progress(k + 1, n)

@@ -5,15 +5,19 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
     /                 attrs: case_toml (the resolved case), version, git_rev, taichi_version, arch, seed,
                       created; + case_name, case_hash, bed, complete (True only in a finished file)
     /series/<name>    1-D float64 datasets over time, attr units (coupling.testbed.SERIES_UNITS)
-    /summary          attrs: <q>_mean, <q>_std, <q>_units for the steady quantities; window_start,
-                      window_end [s], steady (bool), samples
+    /summary          attrs: <q>_mean, <q>_std, <q>_sem (standard error), <q>_drift, <q>_units for the
+                      steady quantities (tread_slip among them); window_start, window_end [s], steady
+                      (bool), samples; + pitches (whole pitches of the tread in the window), pitch_deg,
+                      commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
     /run              + attrs: wall time, step counts, sizes (coupling.testbed.TestbedResult.info)
     /mesh/            nodes0 (N, 3) [m] (wheel in its start pose), triangles (T, 3), beams (B, 2)
     /frames/<k>/      attr t [s]; particles/{position, velocity (float32), radius}, wheel/{nodes,
-                      + deflection (float32: node position less the hub's rigid motion of nodes0)}
+                      + deflection (float32: node position less the wheel's best-fit rigid motion of
+                      nodes0, mass-weighted: its deformation, not its rotation)}
 
-Frames are named with six digits (``000000``...), in time order. The particle radius does not change
-over a run: every frame's ``radius`` is a hard link to the first one's (stored once).
+Frames are named with six digits (``000000``...), in time order. A frame's ``radius`` is a hard link to
+the previous frame's while the spheres are the same (stored once); a moving soil patch renews spheres,
+and the frame after a renewal stores its own.
 
 Writing is atomic: a run writes ``.<name>.partial`` beside the final path and renames it only when
 complete, so a crashed or killed run never leaves a file that looks finished (and ``complete`` is
@@ -23,6 +27,7 @@ can continue it.
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,18 +38,14 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 
 FRAME_FORMAT = "{:06d}"
+#: The statistics a summary keeps for each steady quantity.
+SUMMARY_STATS = ("mean", "std", "sem", "drift", "units")
 
 
 def partial_path(path: str | Path) -> Path:
     """Where a result is written until it is complete."""
     path = Path(path)
     return path.with_name(f".{path.name}.partial")
-
-
-def rigid_deflection(nodes: np.ndarray, nodes0: np.ndarray, hub: np.ndarray, hub0: np.ndarray,
-                     rotation: np.ndarray) -> np.ndarray:
-    """Node displacement less the hub's rigid motion: x - (c + R (X0 - c0)) [m], (N, 3)."""
-    return nodes - (hub + (nodes0 - hub0) @ np.asarray(rotation).T)
 
 
 class ResultWriter:
@@ -101,13 +102,14 @@ class ResultWriter:
         p = g.create_group("particles")
         p.create_dataset("position", data=np.asarray(particles["position"], np.float64))
         p.create_dataset("velocity", data=np.asarray(particles["velocity"], np.float32))
+        radius = np.asarray(particles["radius"], np.float64)
         if self._radius is None and self.n_frames > 0:
-            self._radius = self.file["frames"][FRAME_FORMAT.format(0)]["particles/radius"]
-        if self._radius is None:
-            p.create_dataset("radius", data=np.asarray(particles["radius"], np.float64))
+            self._radius = self.file["frames"][FRAME_FORMAT.format(self.n_frames - 1)]["particles/radius"]
+        if self._radius is not None and self._radius.shape == radius.shape and np.array_equal(self._radius[()], radius):
+            p["radius"] = self._radius  # hard link: one copy of the radii while the spheres are the same
+        else:  # the first frame, or a moving soil patch has renewed spheres since the last one
+            p.create_dataset("radius", data=radius)
             self._radius = p["radius"]
-        else:
-            p["radius"] = self._radius  # hard link: one copy of the radii
         w = g.create_group("wheel")
         w.create_dataset("nodes", data=np.asarray(wheel_nodes, np.float64))
         w.create_dataset("deflection", data=np.asarray(deflection, np.float32))
@@ -129,9 +131,10 @@ class ResultWriter:
         g.attrs["samples"] = int(summary["samples"])
         for q, stats in summary.items():
             if isinstance(stats, dict):
-                g.attrs[f"{q}_mean"] = stats["mean"]
-                g.attrs[f"{q}_std"] = stats["std"]
-                g.attrs[f"{q}_units"] = stats["units"]
+                for key, value in stats.items():
+                    g.attrs[f"{q}_{key}"] = value
+            elif q not in ("window", "steady", "samples"):
+                g.attrs[q] = json.dumps(stats) if isinstance(stats, (list, tuple)) else stats
         r = f.create_group("run")
         for key, value in info.items():
             r.attrs[key] = value
@@ -243,7 +246,9 @@ def load_result(path: str | Path) -> Result:
         summary = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
                    "samples": int(sa.pop("samples"))}
         for key in [k[:-5] for k in sa if k.endswith("_mean")]:
-            summary[key] = {"mean": sa[f"{key}_mean"], "std": sa[f"{key}_std"], "units": sa[f"{key}_units"]}
+            summary[key] = {stat: sa.pop(f"{key}_{stat}") for stat in SUMMARY_STATS if f"{key}_{stat}" in sa}
+        for key, value in sa.items():
+            summary[key] = json.loads(value) if key == "reasons" else value
         attrs = {k: attr_value(v) for k, v in f.attrs.items()}
         info = {k: attr_value(v) for k, v in f["run"].attrs.items()}
         times = np.array([f["frames"][k].attrs["t"] for k in sorted(f["frames"])])

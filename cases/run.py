@@ -28,7 +28,7 @@ from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output, provenance
 
-from .results import ResultWriter, attr_value, partial_path, rigid_deflection
+from .results import ResultWriter, attr_value, partial_path
 from .schema import CaseFile, case_to_toml
 
 RESULT_NAME = "result.h5"
@@ -136,7 +136,6 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     attrs = {"case_toml": case_to_toml(case), "case_name": case.name, "case_hash": case_hash,
              "seed": case.case.seed, "bed": bed.summary(), **prov}
     nodes0 = bench.mesh.nodes.copy()
-    hub0 = bench.structure.hub_position
     mesh = {"nodes0": nodes0, "triangles": bench.mesh.triangles, "beams": bench.mesh.beams.reshape(-1, 2)}
     frame_dt, ckpt_dt = case.output.frame_interval, case.output.checkpoint_interval
     counters = {"frames": 0, "checkpoints": 0}
@@ -151,8 +150,7 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     def add_frame(tb) -> None:
         nodes = tb.structure.positions()
         writer.add_frame(tb.scene.time, {"position": tb.scene.positions, "velocity": tb.scene.velocities,
-                                         "radius": tb.scene.radii}, nodes,
-                         rigid_deflection(nodes, nodes0, tb.structure.hub_position, hub0, tb.structure.hub_rotation))
+                                         "radius": tb.scene.radii}, nodes, tb.deformation(nodes))
         counters["frames"] += 1
 
     def on_sample(tb) -> None:

@@ -97,7 +97,12 @@ class Soil(_Section):
     restitution: float = _q(0.5, "1", "soil--soil coefficient of restitution", gt=0, le=1)
     static_friction: float = _q(0.42, "1", "soil--soil Coulomb friction coefficient", ge=0)
     rolling_friction: float = _q(0.11, "1", "soil--soil rolling friction coefficient", ge=0)
-    time_step: Optional[float] = _q(None, "s", "DEM time step (default: the stable Hertz/Rayleigh estimate)", gt=0)
+    periodic: bool = Field(True, description="prepare the bin periodic along its length: a moving soil patch keeps "
+                                              "fresh soil ahead of the wheel for any drive (the bin need not grow "
+                                              "with test.drive_time)")
+    time_step: Optional[float] = _q(None, "s", "DEM time step of the run (default: the stable Hertz/Rayleigh "
+                                                "estimate); the bed is prepared with that estimate either way",
+                                       gt=0)
     max_settle_time: float = _q(10.0, "s", "give up preparing the bed after this much settling", gt=0)
 
     @field_validator("gravity")
@@ -173,16 +178,29 @@ class Test(_Section):
     lowering_speed: float = _q(0.3, "m/s", "speed at which the rig lowers the wheel until the soil carries W", gt=0)
     settle_time: float = _q(0.1, "s", "rest, free vertically under W, before driving", gt=0)
     spin_up_time: float = _q(0.05, "s", "time over which omega and the carriage speed ramp up", ge=0)
-    drive_time: float = _q(0.6, "s", "time driven at constant omega", gt=0)
-    start_x: Optional[float] = _q(None, "m", "initial hub position along the bin (default: radius + 0.1 m)", gt=0)
+    drive_time: float = _q(4.0, "s", "longest drive after the spin-up; the run ends sooner once it is steady "
+                                     "(stop_when_steady)", gt=0)
+    stop_when_steady: bool = Field(True, description="end the run at the first steady window of "
+                                                     "output.average_time (false: drive the whole drive_time)")
+    windup: Literal["controller", "none"] = Field(
+        "controller", description="'controller': after the spin-up the hub's spin follows the tread's (feedback) "
+                                  "until the wheel has wound up to the tread slip commanded, then holds omega; "
+                                  "'none': hold omega from the spin-up on")
+    windup_gain: float = _q(4.0, "1", "feedback gain of the wind-up controller", gt=0, le=50)
+    max_wind_up: float = _q(0.6, "rad", "stop the run when the tread lags the hub by more than this", gt=0, le=1.5708)
+    start_x: Optional[float] = _q(None, "m", "initial hub position along the bin (default: radius + 0.1 m; the "
+                                             "middle of a periodic bin)", gt=0)
     axle_damping: Optional[float] = _q(None, "N s/m", "damper on the rig's vertical slide (default: wheel "
                                                       "mass / 0.1 s)", ge=0)
 
 
 class Output(_Section):
     sample_interval: float = _q(0.005, "s", "averaging interval of one time-series sample", gt=0)
-    steady_window: float = _q(0.15, "s", "shortest span compared when detecting the steady state", gt=0)
-    steady_tolerance: float = _q(0.15, "1", "relative change allowed between the halves of the steady span", gt=0)
+    average_time: float = _q(1.0, "s", "shortest averaging window once steady (whole pitches of the tread)", gt=0)
+    steady_tolerance: float = _q(0.1, "1", "largest drift over the averaging window, relative to the mean (or a "
+                                           "floor: 5 % of W for forces)", gt=0, le=1)
+    slip_tolerance: float = _q(0.03, "1", "largest difference between tread slip and commanded slip when steady",
+                               gt=0, le=0.5)
     frame_interval: float = _q(0.05, "s", "simulated time between frames (particles, wheel nodes) kept in the "
                                           "result; 0: the last frame only", ge=0)
     checkpoint_interval: float = _q(0.25, "s", "simulated time between checkpoints a killed run resumes from "
@@ -230,7 +248,7 @@ class CaseFile(BaseModel):
             diameter_max=s.diameter_max, gravity=s.gravity_vector,
             material=Material("lunar soil simulant", s.youngs_modulus, s.poisson_ratio, s.density),
             pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
-            seed=self.case.seed, max_settle_time=s.max_settle_time, time_step=s.time_step,
+            seed=self.case.seed, max_settle_time=s.max_settle_time, periodic=s.periodic,
         )
 
     def wheel_geometry(self):
@@ -265,9 +283,12 @@ class CaseFile(BaseModel):
         return TestbedSpec(
             slip=t.slip, slip_angle=t.slip_angle, load=t.load, angular_velocity=t.angular_velocity,
             lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
-            drive_time=t.drive_time, sample_interval=o.sample_interval, steady_window=o.steady_window,
-            steady_tolerance=o.steady_tolerance, start_x=t.start_x, rigid=self.wheel.rigid, damping=self.wheel.damping,
-            axle_damping=t.axle_damping, pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
+            drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
+            windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
+            sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
+            start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid, damping=self.wheel.damping,
+            axle_damping=t.axle_damping,
+            pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
         )
 
 
@@ -367,10 +388,10 @@ def validate_case(data: dict, source: str, *, default_name: str | None = None) -
     if case.case.name is None:
         name = default_name or "case"
         case = case.model_copy(update={"case": case.case.model_copy(update={"name": name})})
-    try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, ...)
-        case.bed_spec()
-        case.wheel_geometry()
-        case.testbed_spec()
+    try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, the drive, ...)
+        from wheelsoil.coupling.testbed import check_fits
+
+        check_fits(case.bed_spec(), case.wheel_geometry(), case.testbed_spec())
     except WheelsoilInputError as exc:
         raise CaseError(source, [str(exc)]) from None
     return case

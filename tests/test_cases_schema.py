@@ -81,9 +81,9 @@ def test_cross_checks_of_the_solver_name_the_problem(tmp_path):
 
 
 def test_units_convert_to_the_keys_unit_and_refuse_other_dimensions(tmp_path):
-    case = load_case(write(tmp_path, '[test]\ndrive_time = "800 ms"\nload = "2.5 kN"\nslip = "40 %"\n'
+    case = load_case(write(tmp_path, '[test]\ndrive_time = "2500 ms"\nload = "2.5 kN"\nslip = "40 %"\n'
                                      'slip_angle = "0.1 rad"\n[soil]\ndiameter_min = "25 mm"\n'))
-    assert case.test.drive_time == pytest.approx(0.8, rel=1e-15)
+    assert case.test.drive_time == pytest.approx(2.5, rel=1e-15)
     assert case.test.load == 2500.0 and case.test.slip == pytest.approx(0.4)
     assert case.test.slip_angle == pytest.approx(math.degrees(0.1))
     assert case.soil.diameter_min == 0.025  # exactly as written in metres

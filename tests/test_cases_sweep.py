@@ -12,7 +12,7 @@ from wheelsoil.cases.schema import CaseError
 from wheelsoil.cases.sweep import load_sweep, run_sweep
 
 COMMON = 'set = { "output.render" = false, "output.frame_interval" = 0.0, "output.checkpoint_interval" = 0.0, ' \
-         '"test.drive_time" = 0.1 }'
+         '"test.drive_time" = 0.1, "test.stop_when_steady" = false, "output.average_time" = 0.05 }'
 
 
 def write(tmp_path, text, name="sweep.toml"):
@@ -49,10 +49,10 @@ def test_bad_sweep_files_name_the_problem(tmp_path):
 
 
 def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retries(bed_cache, tmp_path, capsys):
-    # the middle row cannot run: 5 s of driving leaves the 0.6 m bin (found when the run sets up)
+    # the middle row cannot finish: its wheel may not wind up by more than 0.001 rad (found while it drives)
     path = write(tmp_path, f'[sweep]\nname = "three"\nbase = "mini-1g-steer"\n{COMMON}\n'
                            '[[sweep.rows]]\n"test.slip" = 0.2\n'
-                           '[[sweep.rows]]\n"test.slip" = 0.4\n"test.drive_time" = 5.0\n'
+                           '[[sweep.rows]]\n"test.slip" = 0.4\n"test.max_wind_up" = 0.001\n'
                            '[[sweep.rows]]\n"test.slip" = 0.5\n')
     out = tmp_path / "out"
     assert main(["batch", str(path), "--out", str(out), "--workers", "2"]) == EXIT_SWEEP_FAILED
@@ -60,8 +60,8 @@ def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retrie
     assert "2 run, 0 skipped (finished before), 1 failed" in text
     status = json.loads((out / "status.json").read_text())
     failed = [v for v in status.values() if v["status"] == "failed"]
-    assert len(failed) == 1 and "the bin (length 0.6 m) is too short" in failed[0]["error"]
-    assert failed[0]["values"] == {"test.slip": 0.4, "test.drive_time": 5.0}
+    assert len(failed) == 1 and "past test.max_wind_up = 0.001 rad" in failed[0]["error"]
+    assert failed[0]["values"] == {"test.slip": 0.4, "test.max_wind_up": 0.001}
     csv = pd.read_csv(out / "summary.csv")
     parquet = pd.read_parquet(out / "summary.parquet")
     assert sorted(csv["test.slip"]) == [0.2, 0.5] and len(parquet) == 2

@@ -1,0 +1,374 @@
+"""Convergence study of a case: how far its reported numbers move when the scale is refined.
+
+The "double the box and rerun" check, done for every numerical parameter a testbed result depends on.
+From a base case (a preset or a case file, with overrides) the study makes the reference case and one case
+per refined level of each factor, runs them as a sweep (:mod:`.sweep`: each case in its own process,
+finished cases skipped when the study runs again), and writes a report:
+
+======================  ===============================================================  =================
+factor                  what changes (``scale`` multiplies the reference value)          default levels
+======================  ===============================================================  =================
+``particle_size``       ``soil.diameter_min`` and ``soil.diameter_max`` (finer: < 1)     1, 0.8, 0.64
+``depth``               ``soil.depth``                                                   1, 2
+``width``               ``soil.width``                                                   1, 2
+``time_step``           ``soil.time_step`` (of the reference run: the same bed)          1, 0.5
+``mesh``                ``wheel.element_size``                                           1, 0.5
+======================  ===============================================================  =================
+
+For every factor and each pair of neighbouring levels (coarse -> fine) and for each reported quantity
+(:data:`QUANTITIES`) the report gives the change Delta = q_fine - q_coarse, its relative size
+Delta / max(|q_fine|, floor) (floors as the steady-state detector's: 5 % of W for forces, 5 % of W r for the
+torque, half a mean particle diameter for sinkage, 0.01 for slip) and its standard error
+sqrt(sem_fine^2 + sem_coarse^2) from the batch means over whole pitches of each run's steady window. A
+factor is converged at a level when every quantity changes by less than ``threshold`` (10 %) to the next
+finer level; a run that did not reach a steady state makes its changes unreportable, and the report says so.
+
+The time-step level runs after the reference, at ``scale`` times the DEM step the reference used (read from
+its result); the bed is prepared with its own stable step either way (:class:`~wheelsoil.coupling.testbed.
+TestbedSpec` ``time_step``), so the level tests the step and not a new bed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.provenance import atomic_output
+
+from .run import RESULT_NAME
+from .schema import CaseError, CaseFile, apply_overrides, validate_case
+from .sweep import Sweep, SweepCase, run_sweep
+
+#: Factor -> default scales, reference (1) first, then finer levels (for depth and width: larger).
+DEFAULT_LEVELS = {
+    "particle_size": (1.0, 0.8, 0.64),
+    "depth": (1.0, 2.0),
+    "width": (1.0, 2.0),
+    "time_step": (1.0, 0.5),
+    "mesh": (1.0, 0.5),
+}
+
+#: Reported quantities: summary key -> (label, unit, scale to the printed unit).
+QUANTITIES = {
+    "drawbar_pull": ("drawbar pull", "N", 1.0),
+    "lateral_force": ("lateral force", "N", 1.0),
+    "vertical_force": ("vertical force", "N", 1.0),
+    "torque": ("torque", "N m", 1.0),
+    "sinkage": ("sinkage", "mm", 1e3),
+    "tread_slip": ("tread slip", "1", 1.0),
+}
+
+
+@dataclass
+class Level:
+    """One level of one factor: its scale and the case overrides that make it."""
+
+    factor: str
+    scale: float
+    overrides: dict
+    case: CaseFile | None = None
+    folder: Path | None = None
+
+
+@dataclass
+class ConvergenceStudy:
+    base: CaseFile
+    out: Path
+    levels: dict[str, list[Level]]
+    threshold: float = 0.10
+    reference: Level | None = field(default=None)
+
+    def cases(self) -> list[Level]:
+        """The distinct levels (the reference once)."""
+        seen, out = set(), []
+        for levels in self.levels.values():
+            for lv in levels:
+                if lv.case is not None and lv.folder.name not in seen:
+                    seen.add(lv.folder.name)
+                    out.append(lv)
+        return out
+
+
+def _check_levels(factor: str, scales) -> tuple[float, ...]:
+    scales = tuple(float(s) for s in scales)
+    if factor not in DEFAULT_LEVELS:
+        raise WheelsoilInputError(f"convergence factor {factor!r} is not one of {', '.join(DEFAULT_LEVELS)}")
+    if len(scales) < 2 or scales[0] != 1.0:
+        raise WheelsoilInputError(f"convergence levels of {factor} = {list(scales)}: give the reference 1 first and "
+                                  "at least one more level")
+    if not all(math.isfinite(s) and s > 0 for s in scales) or len(set(scales)) != len(scales):
+        raise WheelsoilInputError(f"convergence levels of {factor} = {list(scales)} must be distinct numbers > 0")
+    return scales
+
+
+def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_step: float | None = None) -> dict:
+    """The case keys that make ``factor`` at ``scale`` times the reference value."""
+    s, w = case.soil, case.wheel
+    if factor == "particle_size":
+        return {"soil.diameter_min": s.diameter_min * scale, "soil.diameter_max": s.diameter_max * scale}
+    if factor == "depth":
+        return {"soil.depth": s.depth * scale}
+    if factor == "width":
+        return {"soil.width": s.width * scale}
+    if factor == "mesh":
+        size = w.element_size if w.element_size is not None else case.wheel_geometry().element_size
+        return {"wheel.element_size": size * scale}
+    if factor == "time_step":
+        if scale == 1.0:
+            return {}
+        if reference_time_step is None:
+            return None  # known once the reference has run
+        return {"soil.time_step": reference_time_step * scale}
+    raise WheelsoilInputError(f"convergence factor {factor!r} is not one of {', '.join(DEFAULT_LEVELS)}")
+
+
+def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, threshold: float = 0.10,
+               reference_time_step: float | None = None) -> ConvergenceStudy:
+    """The study's cases, each validated before anything runs (errors name the factor, level and key)."""
+    out = Path(out)
+    levels = {k: _check_levels(k, v) for k, v in (levels or DEFAULT_LEVELS).items()}
+    if not 0 < threshold < 1:
+        raise WheelsoilInputError(f"threshold = {threshold!r} must lie in (0, 1)")
+    if not base.test.stop_when_steady:
+        pass  # a fixed drive is the user's choice; the report still says whether each run was steady
+    base_data = base.model_dump(mode="json")
+    study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold)
+    if reference_time_step is None and "time_step" in levels and base.soil.time_step is not None:
+        reference_time_step = base.soil.time_step
+    for factor, scales in levels.items():
+        study.levels[factor] = []
+        for scale in scales:
+            over = level_overrides(base, factor, scale, reference_time_step)
+            lv = Level(factor, scale, over or {})
+            if over is not None:
+                data = apply_overrides(base_data, [(k.split("."), v) for k, v in over.items()])
+                label = "reference" if not over else f"{factor}x{scale:g}"
+                data["case"]["name"] = f"{base.name}-{label}"
+                lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")
+                lv.folder = out / "cases" / lv.case.case_hash()
+            study.levels[factor].append(lv)
+            if not over and scale == 1.0 and lv.case is not None:
+                study.reference = lv
+    return study
+
+
+def _sweep_of(study: ConvergenceStudy, levels: list[Level]) -> Sweep:
+    cases = [SweepCase(values={"factor": lv.factor, "scale": lv.scale, **lv.overrides}, case=lv.case, folder=lv.folder)
+             for lv in levels]
+    return Sweep(name=f"convergence-{study.base.name}", cases=cases, out=study.out,
+                 swept_keys=["factor", "scale"])
+
+
+def run_study(study: ConvergenceStudy, *, workers: int = 1, arch: str | None = None, timeout: float | None = None,
+              progress: bool = False, console=None) -> dict:
+    """Run every level (the time-step level after the reference) and write the report; returns the statuses."""
+    status = run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
+                       progress=progress, console=console)
+    pending = [lv for lv in study.levels.get("time_step", []) if lv.case is None]
+    if pending:
+        ref = study.reference
+        if ref is None or not (ref.folder / RESULT_NAME).is_file():
+            raise WheelsoilInputError("the time-step levels need the reference run's DEM step; the reference failed "
+                                      f"(see {study.out / 'status.json'})")
+        from .results import load_result
+
+        dt = float(load_result(ref.folder / RESULT_NAME).info["dem_time_step"])
+        levels = {k: [lv.scale for lv in v] for k, v in study.levels.items()}
+        rebuilt = make_study(study.base, study.out, levels, study.threshold, reference_time_step=dt)
+        study.levels = rebuilt.levels
+        status.update(run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
+                                progress=progress, console=console))
+    write_report(study)
+    return status
+
+
+# -------------------------------------------------------------------- report
+def _floors(case: CaseFile) -> dict:
+    w = case.test.load
+    r = case.wheel_geometry().radius
+    d = 0.5 * (case.soil.diameter_min + case.soil.diameter_max)
+    return {"drawbar_pull": 0.05 * w, "lateral_force": 0.05 * w, "vertical_force": 0.05 * w, "torque": 0.05 * w * r,
+            "sinkage": 0.5 * d, "tread_slip": 0.01}
+
+
+def _level_values(lv: Level) -> dict | None:
+    from .results import load_result
+
+    if lv.folder is None or not (lv.folder / RESULT_NAME).is_file():
+        return None
+    r = load_result(lv.folder / RESULT_NAME)
+    out = {"steady": bool(r.summary["steady"]), "wall_seconds": float(r.info.get("wall_seconds", math.nan)),
+           "particles": int(r.info.get("particles", 0)), "dem_time_step": float(r.info.get("dem_time_step", math.nan))}
+    for q in QUANTITIES:
+        st = r.summary.get(q, {})
+        out[q] = (float(st.get("mean", math.nan)), float(st.get("sem", math.nan)))
+    return out
+
+
+def comparison_rows(study: ConvergenceStudy) -> list[dict]:
+    """One row per factor, neighbouring pair of levels and quantity: the two means, their change, relative change
+    and its standard error, and whether both runs were steady."""
+    floors = _floors(study.base)
+    rows = []
+    for factor, levels in study.levels.items():
+        values = [_level_values(lv) for lv in levels]
+        for k in range(len(levels) - 1):
+            a, b = values[k], values[k + 1]
+            for q in QUANTITIES:
+                row = {"factor": factor, "coarse_scale": levels[k].scale, "fine_scale": levels[k + 1].scale,
+                       "quantity": q, "finished": a is not None and b is not None}
+                if row["finished"]:
+                    (ma, sa), (mb, sb) = a[q], b[q]
+                    ref = max(abs(mb), floors[q])
+                    delta = mb - ma
+                    sigma = math.hypot(sa, sb) if math.isfinite(sa) and math.isfinite(sb) else math.nan
+                    row.update(coarse_mean=ma, coarse_sem=sa, fine_mean=mb, fine_sem=sb, change=delta,
+                               change_sem=sigma, relative_change=delta / ref, relative_change_sem=sigma / ref,
+                               steady=a["steady"] and b["steady"])
+                    row["converged"] = bool(row["steady"] and abs(row["relative_change"]) < study.threshold)
+                rows.append(row)
+    return rows
+
+
+def coarsest_converged(study: ConvergenceStudy, rows: list[dict]) -> dict:
+    """Per factor: the coarsest scale from which every quantity changes by less than the threshold to the next
+    finer level (and on through the finer pairs), or None."""
+    verdict = {}
+    for factor, levels in study.levels.items():
+        pairs = [[r for r in rows if r["factor"] == factor and r["coarse_scale"] == lv.scale] for lv in levels[:-1]]
+        ok = [bool(p) and all(r.get("converged", False) for r in p) for p in pairs]
+        found = None
+        for k in range(len(ok)):
+            if all(ok[k:]):
+                found = levels[k].scale
+                break
+        verdict[factor] = found
+    return verdict
+
+
+def write_report(study: ConvergenceStudy) -> list[Path]:
+    """convergence.csv, convergence.json, convergence.md and convergence.png in the study folder."""
+    import pandas as pd
+
+    rows = comparison_rows(study)
+    verdict = coarsest_converged(study, rows)
+    study.out.mkdir(parents=True, exist_ok=True)
+    table = pd.DataFrame(rows)
+    written = []
+    with atomic_output(study.out / "convergence.csv") as tmp:
+        table.to_csv(tmp, index=False)
+    written.append(study.out / "convergence.csv")
+    levels = {f: [{"scale": lv.scale, "overrides": lv.overrides, "case_hash": lv.folder.name if lv.folder else None,
+                   "values": _level_values(lv)} for lv in lvs] for f, lvs in study.levels.items()}
+    with atomic_output(study.out / "convergence.json") as tmp:
+        tmp.write_text(json.dumps({"base": study.base.name, "threshold": study.threshold, "coarsest_converged": verdict,
+                                   "levels": levels, "comparisons": rows}, indent=2, default=float))
+    written.append(study.out / "convergence.json")
+    with atomic_output(study.out / "convergence.md") as tmp:
+        tmp.write_text(report_markdown(study, rows, verdict, levels))
+    written.append(study.out / "convergence.md")
+    written.append(_plot(study, rows))
+    return written
+
+
+def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, levels: dict) -> str:
+    pct = int(round(100 * study.threshold))
+    lines = [f"# Convergence study: {study.base.name}", "",
+             f"Each factor's levels against the reference; a change is the finer level's mean minus the coarser's, "
+             f"relative to the finer mean (or the floor), ± one standard error (batch means over whole pitches). "
+             f"Converged: every quantity changes by less than {pct} % and both runs were steady.", "",
+             "## Levels", "", "| factor | scale | changes | particles | DEM step [s] | steady | wall [s] | "
+             + " | ".join(f"{v[0]} [{v[1]}]" for v in QUANTITIES.values()) + " |",
+             "|" + "---|" * (7 + len(QUANTITIES))]
+    for factor, lvs in levels.items():
+        for lv in lvs:
+            v = lv["values"]
+            over = ", ".join(f"{k} = {x:.4g}" for k, x in lv["overrides"].items()) or "reference"
+            if v is None:
+                lines.append(f"| {factor} | {lv['scale']:g} | {over} | not run | | | | " + " | " * (len(QUANTITIES) - 1)
+                             + " |")
+                continue
+            cells = [f"{s * v[q][0]:.4g} ± {s * v[q][1]:.2g}" for q, (_, _, s) in QUANTITIES.items()]
+            lines.append(f"| {factor} | {lv['scale']:g} | {over} | {v['particles']} | {v['dem_time_step']:.3g} | "
+                         f"{'yes' if v['steady'] else '**no**'} | {v['wall_seconds']:.0f} | " + " | ".join(cells) + " |")
+    lines += ["", "## Changes between neighbouring levels", "",
+              "| factor | levels | " + " | ".join(v[0] for v in QUANTITIES.values()) + " |",
+              "|" + "---|" * (2 + len(QUANTITIES))]
+    for factor, lvs in study.levels.items():
+        for k in range(len(lvs) - 1):
+            cells = []
+            for q in QUANTITIES:
+                r = next(r for r in rows if r["factor"] == factor and r["coarse_scale"] == lvs[k].scale
+                         and r["quantity"] == q)
+                if not r["finished"]:
+                    cells.append("not run")
+                    continue
+                text = f"{100 * r['relative_change']:+.1f} ± {100 * r['relative_change_sem']:.1f} %"
+                if not r["steady"]:
+                    text += " (not steady)"
+                elif not r["converged"]:
+                    text = f"**{text}**"
+                cells.append(text)
+            lines.append(f"| {factor} | {lvs[k].scale:g} → {lvs[k + 1].scale:g} | " + " | ".join(cells) + " |")
+    lines += ["", "## Verdict", ""]
+    for factor, scale in verdict.items():
+        if scale is None:
+            lines.append(f"- {factor}: **not converged** within {pct} % over the levels run "
+                         f"({', '.join(f'{lv.scale:g}' for lv in study.levels[factor])}); refine further.")
+        else:
+            lines.append(f"- {factor}: converged within {pct} % from scale {scale:g} on.")
+    lines.append("")
+    return "\n".join(lines)
+
+
+def _plot(study: ConvergenceStudy, rows: list[dict]) -> Path:
+    from .plots import _pyplot
+
+    plt = _pyplot()
+    fig, axes = plt.subplots(2, 3, figsize=(12, 6.5), sharey=True)
+    pairs = [(f, lvs[k].scale, lvs[k + 1].scale) for f, lvs in study.levels.items() for k in range(len(lvs) - 1)]
+    labels = [f"{f}\n{a:g}→{b:g}" for f, a, b in pairs]
+    for ax, (q, (label, _, _)) in zip(axes.ravel(), QUANTITIES.items()):
+        for k, (f, a, b) in enumerate(pairs):
+            r = next(r for r in rows if r["factor"] == f and r["coarse_scale"] == a and r["quantity"] == q)
+            if not r["finished"]:
+                continue
+            colour = "C0" if r["steady"] else "0.6"
+            ax.errorbar([k], [100 * r["relative_change"]], yerr=[100 * r["relative_change_sem"]], marker="o",
+                        color=colour, capsize=3)
+        ax.axhspan(-100 * study.threshold, 100 * study.threshold, color="C2", alpha=0.12)
+        ax.axhline(0, color="0.5", lw=0.6)
+        ax.set_title(label)
+        ax.set_xticks(range(len(pairs)))
+        ax.set_xticklabels(labels, fontsize=7)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("change under refinement [%]")
+    fig.suptitle(f"{study.base.name}: change between levels (band: ±{100 * study.threshold:.0f} %; grey: a run "
+                 "not steady)")
+    fig.tight_layout()
+    path = study.out / "convergence.png"
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+    return path
+
+
+def parse_levels(text: str | None, factor: str) -> tuple[float, ...]:
+    """``"1,0.8,0.64"`` -> (1.0, 0.8, 0.64), checked."""
+    if text is None:
+        return DEFAULT_LEVELS[factor]
+    try:
+        values = tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise WheelsoilInputError(f"--{factor.replace('_', '-')}-levels {text!r}: give numbers separated by commas, "
+                                  "e.g. 1,0.8,0.64") from None
+    return _check_levels(factor, values)
+
+
+__all__ = ["DEFAULT_LEVELS", "QUANTITIES", "ConvergenceStudy", "Level", "make_study", "run_study", "write_report",
+           "comparison_rows", "coarsest_converged", "level_overrides", "parse_levels", "CaseError"]

@@ -1,0 +1,101 @@
+"""The convergence study: its levels are the case keys they claim, its arithmetic is the change between
+neighbouring levels with the combined standard error, its verdict is the coarsest level from which every
+pair is within the threshold."""
+
+import math
+
+import pytest
+
+from wheelsoil.cases import convergence as cv
+from wheelsoil.cases.schema import load_case
+from wheelsoil.errors import WheelsoilInputError
+
+
+@pytest.fixture(scope="module")
+def mini():
+    return load_case("mini-1g-steer")
+
+
+def test_levels_change_only_their_keys(mini, tmp_path):
+    study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2), "mesh": (1, 0.5),
+                                           "time_step": (1, 0.5)})
+    ref = study.reference.case
+    ps = study.levels["particle_size"][2].case
+    assert ps.soil.diameter_min == pytest.approx(0.64 * ref.soil.diameter_min)
+    assert ps.soil.diameter_max == pytest.approx(0.64 * ref.soil.diameter_max)
+    assert ps.soil.depth == ref.soil.depth and ps.wheel == ref.wheel and ps.test == ref.test
+    assert study.levels["depth"][1].case.soil.depth == pytest.approx(2 * ref.soil.depth)
+    assert study.levels["mesh"][1].case.wheel.element_size == pytest.approx(0.5 * ref.wheel.element_size)
+    # the reference is one case shared by every factor; the time-step level waits for the reference's step
+    assert len({lv.folder for lv in study.cases()}) == len(study.cases()) == 1 + 2 + 1 + 1
+    assert study.levels["time_step"][1].case is None
+    again = cv.make_study(mini, tmp_path, {"time_step": (1, 0.5)}, reference_time_step=2e-5)
+    assert again.levels["time_step"][1].case.soil.time_step == pytest.approx(1e-5)
+    assert again.levels["time_step"][1].case.bed_spec() == again.reference.case.bed_spec()  # the same bed
+
+
+@pytest.mark.parametrize("levels, message", [
+    ({"particle_size": (0.8, 1.0)}, "reference 1 first"),
+    ({"depth": (1,)}, "at least one more level"),
+    ({"width": (1, -2)}, "distinct numbers > 0"),
+    ({"grain": (1, 2)}, "not one of"),
+])
+def test_bad_levels_are_refused(mini, tmp_path, levels, message):
+    with pytest.raises(WheelsoilInputError, match=message):
+        cv.make_study(mini, tmp_path, levels)
+
+
+def test_parse_levels():
+    assert cv.parse_levels("1, 0.8,0.64", "particle_size") == (1.0, 0.8, 0.64)
+    assert cv.parse_levels(None, "depth") == cv.DEFAULT_LEVELS["depth"]
+    with pytest.raises(WheelsoilInputError, match="numbers separated by commas"):
+        cv.parse_levels("1,fine", "mesh")
+
+
+def _values(scale, steady=True):
+    """Synthetic results: every quantity q(s) = q_inf (1 + 0.2 s^2) with standard error 1 % of the value; the
+    change from s to s' is then 0.2 (s'^2 - s^2) / (1 + 0.2 s'^2) of the finer value."""
+    base = {"drawbar_pull": 500.0, "lateral_force": 200.0, "vertical_force": 3000.0, "torque": 600.0,
+            "sinkage": 0.08, "tread_slip": 0.3}
+    out = {"steady": steady, "wall_seconds": 1.0, "particles": 1, "dem_time_step": 1e-5}
+    for q, v in base.items():
+        m = v * (1 + 0.2 * scale**2)
+        out[q] = (m, 0.01 * m)
+    return out
+
+
+def test_changes_and_verdict(mini, tmp_path, monkeypatch):
+    study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2)})
+    steady = {0.64: False}
+    monkeypatch.setattr(cv, "_level_values",
+                        lambda lv: _values(lv.scale if lv.factor == "particle_size" else 0.1,
+                                           steady=steady.get(lv.scale, True)))
+    rows = cv.comparison_rows(study)
+    r = next(r for r in rows if r["factor"] == "particle_size" and r["coarse_scale"] == 1.0
+             and r["quantity"] == "drawbar_pull")
+    coarse, fine = 500 * 1.2, 500 * (1 + 0.2 * 0.64)
+    assert r["change"] == pytest.approx(fine - coarse)
+    assert r["relative_change"] == pytest.approx((fine - coarse) / fine)
+    assert r["change_sem"] == pytest.approx(math.hypot(0.01 * coarse, 0.01 * fine))
+    # 1 -> 0.8: -6.4 % (converged); 0.8 -> 0.64 not steady, so not converged: no coarsest level
+    assert r["converged"]
+    verdict = cv.coarsest_converged(study, rows)
+    assert verdict["particle_size"] is None
+    assert verdict["depth"] == 1.0
+    steady.clear()
+    assert cv.coarsest_converged(study, cv.comparison_rows(study))["particle_size"] == 1.0
+    tight = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64)}, threshold=0.05)
+    # 1 -> 0.8 changes 6.4 %, 0.8 -> 0.64 4.4 %: converged within 5 % only from 0.8 on
+    assert cv.coarsest_converged(tight, cv.comparison_rows(tight))["particle_size"] == 0.8
+    paths = cv.write_report(tight)
+    text = (tmp_path / "convergence.md").read_text()
+    assert "converged within 5 % from scale 0.8 on" in text and all(p.is_file() for p in paths)
+
+
+def test_unrun_levels_are_reported_as_such(mini, tmp_path):
+    study = cv.make_study(mini, tmp_path, {"width": (1, 2)})
+    rows = cv.comparison_rows(study)
+    assert rows and not any(r["finished"] for r in rows)
+    assert cv.coarsest_converged(study, rows) == {"width": None}
+    cv.write_report(study)
+    assert "not run" in (tmp_path / "convergence.md").read_text()
