@@ -23,8 +23,8 @@ MAIN_HELP = """\
 wheelsoil: a single-wheel terramechanics testbed in software.
 
 Start with the smoke job: the seed-004 lunar-rover wheel (coarse mesh) driven at slip 0.3 and
-steering angle 10 deg through a small regolith bed under Earth gravity with W = 3000 N (about
-three minutes on two cores, bed preparation included):
+steering angle 10 deg through a small regolith bed under Earth gravity with W = 3000 N until steady
+(about six minutes on two cores, bed preparation included):
 
     wheelsoil run
 
@@ -127,8 +127,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "result.xdmf for ParaView), series.csv, summary.json, case.toml (the resolved "
                                    "case), series.png and a render of the last state (final.png) to --out. "
                                    "CASE is a .toml file or a preset ('wheelsoil case list'): smoke-1g-steer (the "
-                                   "default; about 3 minutes on 2 cores with the bed, W = 3000 N), smoke-moon-steer "
-                                   "(1/6 g, W = 500 N), mini-1g-steer (20 s), seed004-1g-steer and seed004-moon-steer "
+                                   "default; about 6 minutes on 2 cores with the bed, W = 3000 N), smoke-moon-steer "
+                                   "(1/6 g, W = 500 N), mini-1g-steer (about 5 minutes), seed004-1g-steer and seed004-moon-steer "
                                    "(full scale, hours). A run killed after a checkpoint continues with --resume. "
                                    "'wheelsoil testbed' is the same command.")
     p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name "

@@ -168,9 +168,10 @@ def render_testbed(result, path: str | Path, **kwargs) -> Path:
     hi[2] = max(hi[2], float(nodes[:, 2].max()))
     spec = result.spec
     tread = result.summary.get("tread_slip", {}).get("mean", float("nan"))
-    kwargs.setdefault("title", f"{result.bed_summary.split(':')[0]}; t = {result.info['simulated_seconds']:.2f} s, "
-                               f"slip {spec.slip:.2f} commanded / {tread:.3f} at the tread (window mean), "
-                               f"steering {spec.slip_angle:g} deg")
+    verdict = "steady" if result.summary.get("steady") else "NOT steady"
+    kwargs.setdefault("title", f"end of the run, t = {result.info['simulated_seconds']:.2f} s ({verdict}): slip "
+                               f"{spec.slip:.2f} commanded, {tread:.3f} at the tread (window mean); steering "
+                               f"{spec.slip_angle:g} deg")
     kwargs.setdefault("arrows", motion_arrows(nodes, spec.slip_angle))
     if result.final_deformation is not None:
         kwargs.setdefault("surface_scalars", 1e3 * np.linalg.norm(result.final_deformation, axis=1))

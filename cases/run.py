@@ -209,7 +209,7 @@ def write_run_folder(out: Path, case: CaseFile, result, prov: dict) -> list[Path
         with atomic_output(out / "final.png") as tmp:
             image = tmp.with_suffix(".png")  # the renderer picks the format from the suffix
             try:
-                render_testbed(result, image, title=f"{case.name}: end of the run")
+                render_testbed(result, image)
                 os.replace(image, tmp)
             finally:
                 image.unlink(missing_ok=True)

@@ -45,6 +45,8 @@ class SteadyState:
     stats: per quantity ``{"mean", "std", "sem", "drift"}`` over the window.
     tread_slip, tread_slip_sem: the tread slip from the window's mean spin and its standard error.
     reasons: why the best candidate window is not steady (empty when steady).
+    bounds: the sample indices of the window's pitch boundaries, latest first (for :func:`window_stats` of
+        other series).
     """
 
     steady: bool
@@ -56,6 +58,7 @@ class SteadyState:
     tread_slip: float = math.nan
     tread_slip_sem: float = math.nan
     reasons: list = field(default_factory=list)
+    bounds: list = field(default_factory=list)
 
 
 def pitch_boundaries(angle: np.ndarray, k_end: int, pitch: float, k_min: int) -> list[int]:
@@ -181,7 +184,7 @@ def detect_steady_state(
             reasons.append(f"tread slip drifts by {slip_drift:+.3f} over the window (allowed "
                            f"+-{slip_tolerance:.3g}): the wheel is still winding up")
     last = SteadyState(not reasons, k0, k1, (float(t[k0] - sample_interval), float(t[k1 - 1])), m, stats,
-                       slip, slip_sem, reasons)
+                       slip, slip_sem, reasons, [int(x) for x in b])
     return last
 
 

@@ -64,7 +64,7 @@ from wheelsoil.granular.timestep import estimate_time_step
 
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
-from .steady import SteadyState, detect_steady_state
+from .steady import SteadyState, detect_steady_state, window_stats
 
 #: Series recorded at every sample, with units.
 SERIES_UNITS = {
@@ -644,7 +644,10 @@ class Testbed:
         }
         for q in STEADY_QUANTITIES:
             y = rows[q][k0:k1]
-            st = state.stats.get(q, {})
+            st = state.stats.get(q)
+            if st is None and len(state.bounds) > 2 and (state.bounds[-1], state.bounds[0]) == (k0, k1):
+                st = window_stats(np.asarray(rows[q], float), state.bounds)  # batch means over the same pitches
+            st = st or {}
             summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
                           "drift": float(st.get("drift", math.nan)), "units": SERIES_UNITS[q]}
         ts = state.stats.get("tread_slip")

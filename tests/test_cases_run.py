@@ -101,6 +101,7 @@ def test_xdmf_sidecar_opens_in_vtks_xdmf_reader(reference):
     assert wheel.GetPointData().GetArray("deflection") is not None
 
 
+@pytest.mark.slow
 def test_a_killed_run_leaves_no_finished_file_and_resume_equals_the_uninterrupted_run(reference, tmp_path):
     case, ref_out, _ = reference
     out = tmp_path / "killed"

@@ -48,6 +48,7 @@ def test_bad_sweep_files_name_the_problem(tmp_path):
         load_sweep(write(tmp_path, '[sweep]\nbase = "no-such-case"\n'))
 
 
+@pytest.mark.slow
 def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retries(bed_cache, tmp_path, capsys):
     # the middle row cannot finish: its wheel may not wind up by more than 0.001 rad (found while it drives)
     path = write(tmp_path, f'[sweep]\nname = "three"\nbase = "mini-1g-steer"\n{COMMON}\n'
@@ -89,6 +90,7 @@ def test_a_sweep_with_one_failing_case_finishes_the_others_then_skips_and_retrie
     assert all((folder / "result.h5").stat().st_mtime_ns == t for folder, t in stamps.items())
 
 
+@pytest.mark.slow
 def test_a_sweep_runs_on_a_dask_cluster(bed_cache, tmp_path):
     distributed = pytest.importorskip("distributed")
     path = write(tmp_path, f'[sweep]\nbase = "mini-1g-steer"\n{COMMON}\n[sweep.grid]\n"test.slip" = [0.3]\n')

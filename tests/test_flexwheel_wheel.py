@@ -156,6 +156,7 @@ def test_bad_material_mesh_and_step_are_refused():
         preset("tractor")
 
 
+@pytest.mark.slow
 def test_wheel_command_meshes_and_load_tests_a_preset(tmp_path, capsys):
     out = tmp_path / "exo"
     assert main(["wheel", "exomars", "--element-size", "0.015", "--points", "3", "--out", str(out)]) == 0

@@ -42,6 +42,7 @@ def test_every_hidden_mechanism_has_a_draw_seed():
     assert set(DRAW_SEEDS) == set(HIDDEN_RANGES)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mechanism", sorted(HIDDEN_RANGES))
 def test_hidden_mechanism_is_named_recovered_and_gains_on_heldout_data(mechanism):
     rng = np.random.default_rng(DRAW_SEEDS[mechanism])
@@ -59,6 +60,7 @@ def test_hidden_mechanism_is_named_recovered_and_gains_on_heldout_data(mechanism
     assert found.gain > 0 and found.delta_bic < -10
 
 
+@pytest.mark.slow
 def test_grouser_tip_radius_is_named_in_a_two_wheel_set():
     """The shearing radius at the grouser tips acts only on a grousered wheel; with one wheel it is the same as a
     larger radius (the surrogate radius), so it is hidden in a set of the grousered wheel and its smooth twin,
@@ -73,6 +75,7 @@ def test_grouser_tip_radius_is_named_in_a_two_wheel_set():
     assert d.found.gain > 0 and d.found.delta_bic < -10
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [7, 8])
 def test_nothing_is_found_where_nothing_is_hidden(seed):
     rng = np.random.default_rng(seed)

@@ -3,10 +3,13 @@
 import json
 import os
 
+import pytest
+
 from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
 from wheelsoil.validation.workflow import validate
 
 
+@pytest.mark.slow
 def test_cmu_large_steering_angles_need_sidewall_resistance(measured_dir, tmp_path):
     """Calibrated on steering angles up to 45 deg, the classical model misses the lateral force at 60 deg;
     of the candidate mechanisms, Schwanghart's sidewall resistance (seed 003 eq. 19) is the one that earns its
@@ -22,6 +25,7 @@ def test_cmu_large_steering_angles_need_sidewall_resistance(measured_dir, tmp_pa
     assert json.loads((tmp_path / "findings.json").read_text())["n_heldout"] > 0
 
 
+@pytest.mark.slow
 def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
     out = tmp_path / "syn"
     assert main(["validate", "synthetic", "--hidden", "slip_sinkage", "--seed", "4", "--report", str(out)]) == EXIT_OK
