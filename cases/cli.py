@@ -128,7 +128,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "case), series.png and a render of the last state (final.png) to --out. "
                                    "CASE is a .toml file or a preset ('wheelsoil case list'): smoke-1g-steer (the "
                                    "default; about 6 minutes on 2 cores with the bed, W = 3000 N), smoke-moon-steer "
-                                   "(1/6 g, W = 500 N), mini-1g-steer (about 5 minutes), seed004-1g-steer and seed004-moon-steer "
+                                   "(1/6 g, W = 500 N, 5-6 minutes), mini-1g-steer (about 5 minutes), "
+                                   "seed004-1g-steer and seed004-moon-steer "
                                    "(full scale, hours). A run killed after a checkpoint continues with --resume. "
                                    "'wheelsoil testbed' is the same command.")
     p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name "

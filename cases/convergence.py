@@ -40,6 +40,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output
 
+from .results import load_result
 from .run import RESULT_NAME
 from .schema import CaseError, CaseFile, apply_overrides, validate_case
 from .sweep import Sweep, SweepCase, run_sweep
@@ -134,8 +135,6 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
     levels = {k: _check_levels(k, v) for k, v in (levels or DEFAULT_LEVELS).items()}
     if not 0 < threshold < 1:
         raise WheelsoilInputError(f"threshold = {threshold!r} must lie in (0, 1)")
-    if not base.test.stop_when_steady:
-        pass  # a fixed drive is the user's choice; the report still says whether each run was steady
     base_data = base.model_dump(mode="json")
     study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold)
     if reference_time_step is None and "time_step" in levels and base.soil.time_step is not None:
@@ -175,8 +174,6 @@ def run_study(study: ConvergenceStudy, *, workers: int = 1, arch: str | None = N
         if ref is None or not (ref.folder / RESULT_NAME).is_file():
             raise WheelsoilInputError("the time-step levels need the reference run's DEM step; the reference failed "
                                       f"(see {study.out / 'status.json'})")
-        from .results import load_result
-
         dt = float(load_result(ref.folder / RESULT_NAME).info["dem_time_step"])
         levels = {k: [lv.scale for lv in v] for k, v in study.levels.items()}
         rebuilt = make_study(study.base, study.out, levels, study.threshold, reference_time_step=dt)
@@ -197,8 +194,6 @@ def _floors(case: CaseFile) -> dict:
 
 
 def _level_values(lv: Level) -> dict | None:
-    from .results import load_result
-
     if lv.folder is None or not (lv.folder / RESULT_NAME).is_file():
         return None
     r = load_result(lv.folder / RESULT_NAME)

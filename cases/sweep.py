@@ -33,6 +33,7 @@ from __future__ import annotations
 import itertools
 import json
 import os
+import socket
 import subprocess
 import sys
 import time
@@ -160,6 +161,26 @@ def load_sweep(path: str | Path, out: str | Path | None = None) -> Sweep:
 
 
 # -------------------------------------------------------------------- running
+def _check_reachable(scheduler: str, wait: float = 5.0) -> None:
+    """Refuse at once a TCP scheduler address that nothing listens on (dask itself retries for its whole
+    connect timeout before it says so); other schemes are left to dask."""
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(scheduler if "://" in scheduler else f"tcp://{scheduler}")
+    if parts.scheme != "tcp":
+        return
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise WheelsoilInputError(f"--scheduler {scheduler!r} is not an address such as tcp://host:8786 ({exc})") from None
+    if not host or port is None:
+        raise WheelsoilInputError(f"--scheduler {scheduler!r} is not an address such as tcp://host:8786")
+    try:
+        socket.create_connection((host, port), timeout=wait).close()
+    except OSError as exc:
+        raise WheelsoilInputError(f"cannot reach the dask scheduler {scheduler!r}: {exc}") from None
+
+
 def execute_case(case_toml: str, folder: str, arch: str | None = None, timeout: float | None = None) -> dict:
     """Run one case in a fresh ``wheelsoil run`` process; never raises. Returns its status.
 
@@ -232,6 +253,7 @@ def run_sweep(sweep: Sweep, *, workers: int | None = None, scheduler: str | None
                 from distributed import Client, as_completed as dask_completed
             except ImportError:
                 raise WheelsoilInputError("--scheduler needs dask.distributed: pip install 'wheelsoil[cluster]'") from None
+            _check_reachable(scheduler)
             try:
                 client = Client(scheduler, timeout="20s")
             except (OSError, TimeoutError) as exc:

@@ -10,7 +10,10 @@ rolling wheel):
 
 * mean of the samples in the window (each sample is already an average over its interval);
 * ``sem``: the standard error of that mean, std(pitch means) / sqrt(number of pitches);
-* ``drift``: the change over the window of the least-squares line through the pitch means.
+* ``drift``: the change over the window of the least-squares line through the pitch means, and
+  ``drift_sem`` its standard error (from the line's residuals). A drift beyond the tolerance fails the window
+  even when it is within its own noise (then the reason says so): the detector does not call a window steady
+  that it cannot tell from a drifting one.
 
 Where the window starts -- how much of the run is start-up transient -- is chosen by the marginal standard
 error rule on the pitch means (MSER: White 1997, Simulation 69, 323; White, Cobb & Spratt 2000; batch means
@@ -94,12 +97,17 @@ def window_stats(y: np.ndarray, bounds: list[int]) -> dict:
     means = np.array([y[b1:b0].mean() for b0, b1 in zip(bounds[:-1], bounds[1:])])[::-1]  # in time order
     m = len(means)
     sem = float(np.std(means, ddof=1) / math.sqrt(m)) if m > 1 else math.inf
-    drift = 0.0
+    drift, drift_sem = 0.0, math.inf
     if m > 1:
         x = np.arange(m, dtype=float)
-        slope = np.polyfit(x, means, 1)[0]
+        slope, icept = np.polyfit(x, means, 1)
         drift = float(slope * (m - 1))
-    return {"mean": float(seg.mean()), "std": float(seg.std()), "sem": sem, "drift": drift}
+        if m > 2:
+            # standard error of the least-squares slope, s / sqrt(sum (x - xbar)^2), s from the m - 2 dof residual
+            resid = means - (slope * x + icept)
+            s = math.sqrt(float(resid @ resid) / (m - 2))
+            drift_sem = float(s / math.sqrt(float(((x - x.mean()) ** 2).sum())) * (m - 1))
+    return {"mean": float(seg.mean()), "std": float(seg.std()), "sem": sem, "drift": drift, "drift_sem": drift_sem}
 
 
 def detect_steady_state(
@@ -167,7 +175,9 @@ def detect_steady_state(
         bm = batches[name][n_pitches - m:]
         step = float(bm[half:].mean() - bm[:half].mean())
         if abs(st["drift"]) > allowed:
-            reasons.append(f"{name} drifts by {st['drift']:+.4g} over the window (allowed +-{allowed:.3g})")
+            reasons.append(f"{name} drifts by {st['drift']:+.4g} +- {st['drift_sem']:.2g} over the window (allowed "
+                           f"+-{allowed:.3g})" + ("; within its own noise: a longer window would tell"
+                                                  if abs(st["drift"]) < 2.0 * st["drift_sem"] else ""))
         elif abs(step) > allowed:
             reasons.append(f"{name} changes by {step:+.4g} between the window's halves (allowed +-{allowed:.3g})")
     w = slice(n_pitches - m, n_pitches)

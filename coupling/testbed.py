@@ -58,12 +58,13 @@ from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
-from wheelsoil.granular.bed import Bed, BedSpec
+from wheelsoil.granular.bed import Bed, BedSpec, check_memory
 from wheelsoil.granular.materials import SOIL_STEEL, PairProperties
 from wheelsoil.granular.timestep import estimate_time_step
 
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
+from .patch import MovingPatch, PatchGeometry
 from .steady import SteadyState, detect_steady_state, window_stats
 
 #: Series recorded at every sample, with units.
@@ -255,11 +256,10 @@ def wheel_period(wheel: WheelGeometry) -> float:
 
 
 def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
-    """Check that the wheel fits the bin and that the bin (or the moving patch on a periodic bin) holds the drive,
-    before any bed is prepared; returns the hub's start position along the bin [m]. The errors name the case keys
+    """Check that the bed fits the machine's memory, that the wheel fits the bin and that the bin (or the moving
+    patch on a periodic bin) holds the drive, before any bed is prepared; returns the hub's start position along the bin [m]. The errors name the case keys
     and values."""
-    from .patch import PatchGeometry
-
+    check_memory(bed)
     beta = math.radians(spec.slip_angle)
     outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
     # footprint across the bin: the width turned by beta plus a contact length of about one radius
@@ -321,8 +321,6 @@ class Testbed:
         self.periodic = bool(bs.periodic)
         start_x = check_fits(bs, wheel, spec)
         if self.periodic:
-            from .patch import MovingPatch
-
             self.patch = MovingPatch(bed, wheel_reach=outer, shift=spec.patch_shift or 0.2 * wheel.radius)
             self.patch.check_start(start_x)
         else:

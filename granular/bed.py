@@ -20,6 +20,7 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -297,9 +298,14 @@ class Bed:
 
 
 # ---------------------------------------------------------------------- preparation
-def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
-    """Jittered loose lattice of spheres filling the bin; returns positions, radii, fill-top height."""
-    rng = np.random.default_rng(spec.seed)
+#: Peak resident memory per particle while a bed is prepared and stepped [bytes]: an upper bound, about 2.5 x
+#: the 1.5 KiB per sphere measured stepping a 388,026-sphere bed (692 MiB peak less the 110 MiB interpreter;
+#: benchmarks/README.md, memory check), for the pair list of a dense bed and the host copies of the state.
+BYTES_PER_PARTICLE = 4096
+
+
+def _lattice(spec: BedSpec) -> tuple[int, int, int, float, float]:
+    """The fill lattice of :func:`initial_packing`: (nx, ny, layers, spacing_x, spacing) [-, -, -, m, m]."""
     r_max = 0.5 * spec.diameter_max
     spacing = spec.diameter_max * 1.05
     nx = int((spec.length - 2 * r_max) // spacing) + 1
@@ -310,6 +316,45 @@ def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
         spacing_x = spec.length / nx
     needed = spec.overfill * 0.6 * spec.length * spec.width * spec.depth / spec.mean_particle_volume
     layers = max(2, int(math.ceil(needed / (nx * ny))))
+    return nx, ny, layers, spacing_x, spacing
+
+
+def fill_particles(spec: BedSpec) -> int:
+    """Spheres in the fill lattice, the most a bed holds while it is prepared (before levelling)."""
+    nx, ny, layers, _, _ = _lattice(spec)
+    return nx * ny * layers
+
+
+def machine_memory() -> int:
+    """Physical memory of this machine [bytes] (0 where the platform does not say)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, OSError, ValueError):
+        return 0
+
+
+def check_memory(spec: BedSpec, available: int | None = None, share: float = 0.8) -> int:
+    """Refuse, before any work, a bed whose estimated peak memory (:data:`BYTES_PER_PARTICLE` per sphere of the
+    fill) exceeds ``share`` of ``available`` bytes (default: this machine's memory); returns the estimate
+    [bytes]. The message names the case keys that set the particle count."""
+    n = fill_particles(spec)
+    need = n * BYTES_PER_PARTICLE
+    available = machine_memory() if available is None else int(available)
+    if available > 0 and need > share * available:
+        raise WheelsoilInputError(
+            f"the bed (soil.length x width x depth = {spec.length:g} x {spec.width:g} x {spec.depth:g} m of "
+            f"soil.diameter_min..diameter_max = {1e3 * spec.diameter_min:g}-{1e3 * spec.diameter_max:g} mm "
+            f"particles) holds about {n:,} spheres while it is prepared, about {need / 2**30:.3g} GiB, more than "
+            f"{share:.0%} of the {available / 2**30:.3g} GiB this machine has: use larger particles or a smaller bin"
+        )
+    return need
+
+
+def initial_packing(spec: BedSpec) -> tuple[np.ndarray, np.ndarray, float]:
+    """Jittered loose lattice of spheres filling the bin; returns positions, radii, fill-top height."""
+    rng = np.random.default_rng(spec.seed)
+    r_max = 0.5 * spec.diameter_max
+    nx, ny, layers, spacing_x, spacing = _lattice(spec)
     ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(layers), indexing="ij")
     # centre the lattice in the bin
     x0 = 0.5 * (spec.length - (nx - 1) * spacing_x)
@@ -419,6 +464,7 @@ def prepare_bed(
         bed.meta.update(cache_path=str(path), from_cache=True)
         return bed
 
+    check_memory(spec)
     runtime.init(arch)
     wall_clock = time.perf_counter()
     positions, radii, fill_top = initial_packing(spec)

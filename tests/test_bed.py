@@ -124,3 +124,32 @@ def test_column_order_groups_spheres_into_columns():
         column_order(positions, 0.0)
     with pytest.raises(ValueError, match="shape"):
         column_order(positions[:, :2], 0.05)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_fill_particle_estimate_is_the_lattice_count(periodic):
+    from wheelsoil.granular.bed import fill_particles, initial_packing
+
+    spec = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015, periodic=periodic)
+    positions, _, _ = initial_packing(spec)
+    assert fill_particles(spec) == len(positions)
+
+
+def test_a_bed_past_the_machine_memory_is_refused_before_any_work_naming_the_keys():
+    """A 2 x 0.9 x 0.2 m bin of 1-1.5 mm particles (about 2e8 spheres: the 'bin of 1e9 particles' that used to
+    end in MemoryError) is refused by the estimate alone, without allocating; the message names the keys."""
+    import time
+
+    from wheelsoil.granular.bed import BYTES_PER_PARTICLE, check_memory, fill_particles
+
+    spec = BedSpec(length=2.0, width=0.9, depth=0.2, diameter_min=0.001, diameter_max=0.0015)
+    t0 = time.perf_counter()
+    with pytest.raises(WheelsoilInputError) as info:
+        check_memory(spec, available=24 * 2**30)
+    assert time.perf_counter() - t0 < 1.0
+    text = str(info.value)
+    assert "soil.diameter_min" in text and "soil.length" in text and "GiB" in text
+    with pytest.raises(WheelsoilInputError):
+        prepare_bed(spec, use_cache=False)  # the same check, before the lattice is built
+    small = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015)
+    assert check_memory(small, available=24 * 2**30) == fill_particles(small) * BYTES_PER_PARTICLE

@@ -108,3 +108,5 @@ def test_an_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
     path = write(tmp_path, f'[sweep]\nbase = "mini-1g-steer"\n{COMMON}\n')
     assert main(["batch", str(path), "--out", str(tmp_path / "x"), "--scheduler", "tcp://127.0.0.1:9"]) == 2
     assert "cannot reach the dask scheduler" in capsys.readouterr().err
+    assert main(["batch", str(path), "--out", str(tmp_path / "y"), "--scheduler", "tcp://127.0.0.1"]) == 2
+    assert "not an address such as tcp://host:8786" in capsys.readouterr().err

@@ -52,3 +52,10 @@ def test_cli_bad_input_exit_code(tmp_path, capsys):
         main(["prepare-bed", "--gravity", "jupiter"])
     assert exc.value.code == 2
     assert main(["render", str(tmp_path / "missing.h5")]) == EXIT_INPUT
+
+
+def test_case_check_refuses_a_bed_past_the_machine_memory(capsys):
+    assert main(["case", "check", "smoke-1g-steer", "--set", "soil.diameter_min=0.001",
+                 "--set", "soil.diameter_max=0.0015"]) == EXIT_INPUT
+    err = capsys.readouterr().err
+    assert "soil.diameter_min" in err and "GiB" in err and "Traceback" not in err

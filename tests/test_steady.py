@@ -99,3 +99,46 @@ def test_windows_are_whole_periods_when_spokes_and_grousers_differ():
     t, series, angle, speed = synthetic_run(3)
     state = detect(t, series, angle, speed, period_pitches=2)
     assert state.steady and state.pitches % 2 == 0
+
+
+@pytest.mark.parametrize("m", [4, 8])
+def test_the_drift_standard_error_matches_the_scatter_of_drifts_over_many_seeds(m):
+    """Pitch means on a line with white noise sigma: the drift's standard error from one window agrees (on
+    average over 400 draws) with the standard deviation of the drift across draws, sigma (m - 1) /
+    sqrt(sum (x - xbar)^2), within 10 %; the drift itself is unbiased within three of its standard errors."""
+    from wheelsoil.coupling.steady import window_stats
+
+    sigma, slope = 5.0, 2.0
+    x = np.arange(m, dtype=float)
+    bounds = list(range(m, -1, -1))  # one sample per pitch
+    rng = np.random.default_rng(1000 + m)
+    drifts, sems = [], []
+    for _ in range(400):
+        st = window_stats(100.0 + slope * x + rng.normal(0.0, sigma, m), bounds)
+        drifts.append(st["drift"])
+        sems.append(st["drift_sem"])
+    exact = sigma * (m - 1) / math.sqrt(((x - x.mean()) ** 2).sum())
+    assert np.std(drifts) == pytest.approx(exact, rel=0.1)
+    assert np.sqrt(np.mean(np.square(sems))) == pytest.approx(exact, rel=0.1)
+    assert abs(np.mean(drifts) - slope * (m - 1)) < 3 * exact / math.sqrt(400)
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13, 14])
+def test_a_drift_within_its_noise_beyond_the_tolerance_is_refused_and_says_so(seed):
+    """A flat but very noisy force (pitch means scattered by 40 % of the mean) over a short window: the
+    detector cannot tell it from a drifting one, so the window is not steady whenever its drift exceeds the
+    tolerance, and the reason says when the drift is within its own noise (a longer window would tell)
+    instead of implying a trend; a drift within the tolerance gives no drift reason."""
+    t, series, angle, speed = synthetic_run(seed, t_end=1.6, tau=0.01)
+    rng = np.random.default_rng(seed)
+    pitch_of = np.floor(angle / PITCH).astype(int)
+    series["drawbar_pull"] = series["drawbar_pull"] + rng.normal(0.0, 400.0, pitch_of.max() + 1)[pitch_of]
+    state = detect(t, series, angle, speed)
+    st = state.stats["drawbar_pull"]
+    assert math.isfinite(st["drift_sem"]) and st["drift_sem"] > 0
+    reasons = [r for r in state.reasons if r.startswith("drawbar_pull drifts")]
+    if abs(st["drift"]) > 0.1 * max(abs(st["mean"]), 150.0):
+        assert not state.steady and len(reasons) == 1
+        assert ("within its own noise" in reasons[0]) == (abs(st["drift"]) < 2 * st["drift_sem"])
+    else:
+        assert reasons == []

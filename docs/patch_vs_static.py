@@ -1,0 +1,127 @@
+"""The moving soil patch against a long static bin: the same run twice, compared over the same window.
+
+Issue 17 asks that a run on a moving patch (a periodic bed whose soil behind the wheel is renewed ahead of
+it, ``coupling/patch.py``) give the same forces as the same run in a bin long enough for the whole drive,
+within the fluctuation. This runs ``mini-1g-steer`` (or ``--case``) for a fixed drive both ways --
+
+* patch: the preset's periodic 0.6 m bed (``soil.periodic = true``);
+* static: ``soil.periodic = false`` and ``soil.length`` long enough for the drive (1.3 m for the mini case);
+
+-- and compares drawbar pull, lateral and vertical force, torque, sinkage and tread slip over one common
+window of whole grouser pitches (the patch run's last ``--pitches`` pitches of the tread's rotation): the
+difference of the means and its standard error sqrt(se_patch^2 + se_static^2), each from the pitch means
+(batch means, ``coupling/steady.py``). The two beds are different random packings, so the difference also
+holds the bed-to-bed scatter a user would meet anyway. "Same within the fluctuation": |difference| <= 2 SE.
+
+Usage (from the repository root; about 7 minutes on 2 CPU cores, finished runs are reused)::
+
+    python docs/patch_vs_static.py                 # run what is missing, print and write the table
+    python docs/patch_vs_static.py --report-only   # the table from finished runs
+
+Runs go to ``wheelsoil-output/patch-vs-static/{patch,static}/``; the table to
+``docs/patch-vs-static.md``.
+"""
+
+import argparse
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent
+QUANTITIES = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "vertical_force": ("N", 1.0),
+              "torque": ("N m", 1.0), "sinkage": ("mm", 1e3), "tread_slip": ("1", 1.0)}
+COMMON = ["test.stop_when_steady=false"]
+STATIC = {"mini-1g-steer": ["soil.periodic=false", "soil.length=1.3"]}
+
+
+def read_series(folder: Path) -> dict:
+    with open(folder / "series.csv") as f:
+        rows = list(csv.reader(f))
+    head = [h.split("[")[0] for h in rows[0]]
+    data = np.array(rows[1:], float)
+    return {h: data[:, k] for k, h in enumerate(head)}
+
+
+def pitch_blocks(series: dict, pitch_deg: float, t0: float, t1: float) -> list[tuple[int, int]]:
+    """Sample ranges of whole pitches of the tread's rotation in [t0, t1] (the tread angle integrated from the
+    tread's spin rate, as the detector does)."""
+    t = series["t"]
+    dt = np.diff(t, prepend=0.0)
+    angle = np.cumsum(series["tread_omega"] * dt)
+    pitch = math.radians(pitch_deg)
+    k0, k1 = int(np.searchsorted(t, t0)), int(np.searchsorted(t, t1))
+    blocks, start = [], k0
+    for k in range(k0, k1):
+        if angle[k] - angle[start] >= pitch:
+            blocks.append((start, k + 1))
+            start = k + 1
+    return blocks
+
+
+def block_stats(y: np.ndarray, blocks) -> tuple[float, float]:
+    means = np.array([y[a:b].mean() for a, b in blocks])
+    return float(means.mean()), float(means.std(ddof=1) / math.sqrt(len(means)))
+
+
+def run(case: str, folder: Path, overrides: list[str], drive_time: float) -> None:
+    if (folder / "summary.json").is_file():
+        return
+    cmd = [sys.executable, "-m", "wheelsoil.cases.cli", "run", case, "--no-render", "--out", str(folder),
+           "--set", f"test.drive_time={drive_time}"]
+    for o in COMMON + overrides:
+        cmd += ["--set", o]
+    print(" ".join(cmd), flush=True)
+    subprocess.run(cmd, check=True)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--case", default="mini-1g-steer")
+    ap.add_argument("--drive-time", type=float, default=3.0)
+    ap.add_argument("--pitches", type=int, default=4, help="pitches of the common window (default 4)")
+    ap.add_argument("--out", default="wheelsoil-output/patch-vs-static")
+    ap.add_argument("--report-only", action="store_true")
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    if args.case not in STATIC:
+        ap.error(f"--case {args.case!r}: the static bin length is known for {', '.join(STATIC)}")
+    if not args.report_only:
+        run(args.case, out / "patch", [], args.drive_time)
+        run(args.case, out / "static", STATIC[args.case], args.drive_time)
+    pitch_deg = float(json.loads((out / "patch" / "summary.json").read_text())["summary"]["pitch_deg"])
+    patch, static = read_series(out / "patch"), read_series(out / "static")
+    t1 = min(patch["t"][-1], static["t"][-1])
+    # the last --pitches whole pitches before t1, from the patch run's tread rotation
+    blocks_all = pitch_blocks(patch, pitch_deg, 0.5, t1)
+    t0 = patch["t"][blocks_all[-args.pitches][0]]
+    bp = pitch_blocks(patch, pitch_deg, t0, t1)
+    bs = pitch_blocks(static, pitch_deg, t0, t1)
+    lines = [f"# Moving patch against a long static bin ({args.case}, {args.drive_time:g} s drive)", "",
+             f"Generated by `python docs/patch_vs_static.py` (window {t0:.2f}-{t1:.2f} s: {len(bp)} pitches of "
+             f"{pitch_deg:g} deg of the patch run's tread, {len(bs)} of the static run's). Mean +- standard error "
+             "from the pitch means; SE of the difference sqrt(se_p^2 + se_s^2); same within the fluctuation when "
+             "|difference| <= 2 SE.", "",
+             "| quantity | patch | static bin | difference | 2 SE | same |", "|---|---|---|---|---|---|"]
+    same_all = True
+    for q, (unit, scale) in QUANTITIES.items():
+        mp, sp = block_stats(patch[q] * scale, bp)
+        ms, ss = block_stats(static[q] * scale, bs)
+        d, se = mp - ms, math.hypot(sp, ss)
+        same = abs(d) <= 2 * se
+        same_all &= same
+        lines.append(f"| {q} [{unit}] | {mp:.4g} ± {sp:.2g} | {ms:.4g} ± {ss:.2g} | {d:+.3g} | {2 * se:.2g} | "
+                     f"{'yes' if same else '**no**'} |")
+    lines += ["", f"All the same within the fluctuation: {'yes' if same_all else 'no'}."]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    (ROOT / "patch-vs-static.md").write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
