@@ -201,6 +201,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--threshold", type=float, default=0.10, help="largest relative change called converged "
                                                                  "(default 0.10)")
     p.add_argument("--out", type=Path, default=None, help="study folder (default wheelsoil-output/convergence/<case>)")
+    p.add_argument("--level-drive-time", type=float, default=None,
+                   help="longest drive of the refined levels in s (default twice the case's test.drive_time; "
+                        "a run stops once steady)")
     p.add_argument("--workers", type=int, default=1, help="cases run at once (default 1: a coupled run uses both "
                                                           "cores of a small machine)")
     p.add_argument("--timeout", type=float, default=None, help="give up a case after this many seconds")
@@ -432,7 +435,8 @@ def cmd_batch(args) -> int:
 
 
 def cmd_convergence(args) -> int:
-    from .convergence import DEFAULT_LEVELS, make_study, parse_levels, run_study, write_report
+    from .convergence import (DEFAULT_LEVELS, make_study, parse_levels, plan, resolve_time_step_levels,
+                              run_study, write_report)
     from .schema import load_case
 
     console = _console()
@@ -447,13 +451,19 @@ def cmd_convergence(args) -> int:
         raise _InputError(f"--timeout {args.timeout} must be > 0 seconds")
     levels = {f: parse_levels(getattr(args, f"{f}_levels"), f) for f in factors}
     out = args.out or Path("wheelsoil-output") / "convergence" / case.name
-    study = make_study(case, out, levels, args.threshold)
+    if args.level_drive_time is not None and not args.level_drive_time > 0:
+        raise _InputError(f"--level-drive-time {args.level_drive_time} must be > 0 seconds")
+    study = make_study(case, out, levels, args.threshold, level_drive_time=args.level_drive_time)
     if args.report_only:
         paths = write_report(study)
     else:
+        resolve_time_step_levels(study)  # with the others when the reference has already run
         console.print(f"convergence study of {case.name}: {len(study.cases())} cases "
                       f"(+ {sum(lv.case is None for lvs in study.levels.values() for lv in lvs)} time-step levels after the reference) "
-                      f"in {out}")
+                      f"in {out}; estimated soil cost per simulated second against the reference:")
+        for row in plan(study):
+            console.print(f"  {row['factor']:>13s} x {row['scale']:<5g} ~{row['particles']:>9,} particles, "
+                          f"soil cost x {row['relative_soil_cost']:.2g}, drive up to {row['drive_time']:g} s")
         run_study(study, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
         paths = [out / n for n in ("convergence.md", "convergence.csv", "convergence.json", "convergence.png")]

@@ -23,6 +23,9 @@ sqrt(sem_fine^2 + sem_coarse^2) from the batch means over whole pitches of each 
 factor is converged at a level when every quantity changes by less than ``threshold`` (10 %) to the next
 finer level; a run that did not reach a steady state makes its changes unreportable, and the report says so.
 
+The refined levels may drive up to twice the base case's ``test.drive_time`` (``--level-drive-time``): they
+stop once steady, like the reference, but a finer bed's quantities settle more slowly per simulated second.
+
 The time-step level runs after the reference, at ``scale`` times the DEM step the reference used (read from
 its result); the bed is prepared with its own stable step either way (:class:`~wheelsoil.coupling.testbed.
 TestbedSpec` ``time_step``), so the level tests the step and not a new bed.
@@ -83,6 +86,7 @@ class ConvergenceStudy:
     levels: dict[str, list[Level]]
     threshold: float = 0.10
     reference: Level | None = field(default=None)
+    level_drive_time: float | None = None
 
     def cases(self) -> list[Level]:
         """The distinct levels (the reference once)."""
@@ -93,6 +97,23 @@ class ConvergenceStudy:
                     seen.add(lv.folder.name)
                     out.append(lv)
         return out
+
+
+def plan(study: ConvergenceStudy) -> list[dict]:
+    """Before anything runs: each level's estimated particle count (0.6 of the bin volume over the mean sphere
+    volume) and the soil's cost per simulated second relative to the reference (particles x steps per second;
+    the stable DEM step is proportional to the smallest radius, and a time-step level's step is its scale)."""
+    ref = study.base.bed_spec()
+    n_ref = 0.6 * ref.length * ref.width * ref.depth / ref.mean_particle_volume
+    out = []
+    for lv in study.cases() + [lv for lvs in study.levels.values() for lv in lvs if lv.case is None]:
+        spec = (lv.case or study.base).bed_spec()
+        n = 0.6 * spec.length * spec.width * spec.depth / spec.mean_particle_volume
+        steps = ref.diameter_min / spec.diameter_min / (lv.scale if lv.factor == "time_step" else 1.0)
+        out.append({"factor": lv.factor, "scale": lv.scale, "particles": int(round(n)),
+                    "relative_soil_cost": n / n_ref * steps,
+                    "drive_time": study.base.test.drive_time if lv.scale == 1.0 else study.level_drive_time})
+    return out
 
 
 def _check_levels(factor: str, scales) -> tuple[float, ...]:
@@ -129,14 +150,24 @@ def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_st
 
 
 def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, threshold: float = 0.10,
-               reference_time_step: float | None = None) -> ConvergenceStudy:
-    """The study's cases, each validated before anything runs (errors name the factor, level and key)."""
+               reference_time_step: float | None = None, level_drive_time: float | None = None) -> ConvergenceStudy:
+    """The study's cases, each validated before anything runs (errors name the factor, level and key).
+
+    level_drive_time: the longest drive of the refined levels [s] (default: twice the base case's
+    ``test.drive_time`` when the base stops once steady, else the base's). A finer or larger bed is noisier
+    per pitch or slower to settle; a run stops once it is steady, so the longer limit changes nothing for a
+    level that would have been steady within the base's, and the reference keeps the base case unchanged."""
     out = Path(out)
     levels = {k: _check_levels(k, v) for k, v in (levels or DEFAULT_LEVELS).items()}
     if not 0 < threshold < 1:
         raise WheelsoilInputError(f"threshold = {threshold!r} must lie in (0, 1)")
+    if level_drive_time is None:
+        level_drive_time = base.test.drive_time * (2.0 if base.test.stop_when_steady else 1.0)
+    if not (math.isfinite(level_drive_time) and level_drive_time >= base.test.drive_time):
+        raise WheelsoilInputError(f"level drive time = {level_drive_time!r} s must be at least the case's "
+                                  f"test.drive_time = {base.test.drive_time} s")
     base_data = base.model_dump(mode="json")
-    study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold)
+    study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold, level_drive_time=level_drive_time)
     if reference_time_step is None and "time_step" in levels and base.soil.time_step is not None:
         reference_time_step = base.soil.time_step
     for factor, scales in levels.items():
@@ -145,14 +176,15 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
             over = level_overrides(base, factor, scale, reference_time_step)
             lv = Level(factor, scale, over or {})
             if over is not None:
-                data = apply_overrides(base_data, [(k.split("."), v) for k, v in over.items()])
-                label = "reference" if not over else f"{factor}x{scale:g}"
+                extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
+                data = apply_overrides(base_data, [(k.split("."), v) for k, v in {**over, **extra}.items()])
+                label = "reference" if scale == 1.0 else f"{factor}x{scale:g}"
                 data["case"]["name"] = f"{base.name}-{label}"
                 lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")
                 lv.folder = out / "cases" / lv.case.case_hash()
             study.levels[factor].append(lv)
-            if not over and scale == 1.0 and lv.case is not None:
-                study.reference = lv
+            if scale == 1.0 and lv.case is not None:
+                study.reference = lv  # every factor's scale 1 is the base case itself
     return study
 
 
@@ -163,21 +195,31 @@ def _sweep_of(study: ConvergenceStudy, levels: list[Level]) -> Sweep:
                  swept_keys=["factor", "scale"])
 
 
+def resolve_time_step_levels(study: ConvergenceStudy) -> bool:
+    """Make the time-step levels' cases from the finished reference's DEM step; False while it has not run."""
+    if not any(lv.case is None for lv in study.levels.get("time_step", [])):
+        return True
+    ref = study.reference
+    if ref is None or not (ref.folder / RESULT_NAME).is_file():
+        return False
+    dt = float(load_result(ref.folder / RESULT_NAME).info["dem_time_step"])
+    levels = {k: [lv.scale for lv in v] for k, v in study.levels.items()}
+    study.levels = make_study(study.base, study.out, levels, study.threshold, reference_time_step=dt,
+                              level_drive_time=study.level_drive_time).levels
+    return True
+
+
 def run_study(study: ConvergenceStudy, *, workers: int = 1, arch: str | None = None, timeout: float | None = None,
               progress: bool = False, console=None) -> dict:
-    """Run every level (the time-step level after the reference) and write the report; returns the statuses."""
+    """Run every level (the time-step level after the reference, or with the others when the reference has
+    finished before) and write the report; returns the statuses."""
+    resolve_time_step_levels(study)
     status = run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
                        progress=progress, console=console)
-    pending = [lv for lv in study.levels.get("time_step", []) if lv.case is None]
-    if pending:
-        ref = study.reference
-        if ref is None or not (ref.folder / RESULT_NAME).is_file():
+    if any(lv.case is None for lv in study.levels.get("time_step", [])):
+        if not resolve_time_step_levels(study):
             raise WheelsoilInputError("the time-step levels need the reference run's DEM step; the reference failed "
                                       f"(see {study.out / 'status.json'})")
-        dt = float(load_result(ref.folder / RESULT_NAME).info["dem_time_step"])
-        levels = {k: [lv.scale for lv in v] for k, v in study.levels.items()}
-        rebuilt = make_study(study.base, study.out, levels, study.threshold, reference_time_step=dt)
-        study.levels = rebuilt.levels
         status.update(run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
                                 progress=progress, console=console))
     write_report(study)
@@ -312,11 +354,21 @@ def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, le
             lines.append(f"| {factor} | {lvs[k].scale:g} → {lvs[k + 1].scale:g} | " + " | ".join(cells) + " |")
     lines += ["", "## Verdict", ""]
     for factor, scale in verdict.items():
-        if scale is None:
-            lines.append(f"- {factor}: **not converged** within {pct} % over the levels run "
-                         f"({', '.join(f'{lv.scale:g}' for lv in study.levels[factor])}); refine further.")
-        else:
+        mine = [r for r in rows if r["factor"] == factor]
+        scales = ", ".join(f"{lv.scale:g}" for lv in study.levels[factor])
+        if scale is not None:
             lines.append(f"- {factor}: converged within {pct} % from scale {scale:g} on.")
+        elif not all(r["finished"] for r in mine):
+            lines.append(f"- {factor}: **undecided**: not every level ({scales}) has finished.")
+        elif not all(r["steady"] for r in mine):
+            unsteady = sorted({lv.scale for lv in study.levels[factor]
+                               if (v := _level_values(lv)) is not None and not v["steady"]})
+            big = [r for r in mine if r["steady"] and not r["converged"]]
+            lines.append(f"- {factor}: **undecided**: the level(s) at scale {', '.join(f'{x:g}' for x in unsteady)} "
+                         "did not reach a steady state, so their changes are not reportable"
+                         + (f"; between steady levels {len(big)} change(s) exceed {pct} %" if big else "") + ".")
+        else:
+            lines.append(f"- {factor}: **not converged** within {pct} % over the levels run ({scales}); refine further.")
     lines.append("")
     return "\n".join(lines)
 

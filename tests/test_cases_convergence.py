@@ -23,7 +23,13 @@ def test_levels_change_only_their_keys(mini, tmp_path):
     ps = study.levels["particle_size"][2].case
     assert ps.soil.diameter_min == pytest.approx(0.64 * ref.soil.diameter_min)
     assert ps.soil.diameter_max == pytest.approx(0.64 * ref.soil.diameter_max)
-    assert ps.soil.depth == ref.soil.depth and ps.wheel == ref.wheel and ps.test == ref.test
+    assert ps.soil.depth == ref.soil.depth and ps.wheel == ref.wheel
+    # refined levels may drive twice as long (they stop once steady); nothing else of the test changes
+    assert ps.test == ref.test.model_copy(update={"drive_time": 2 * ref.test.drive_time})
+    longer = cv.make_study(mini, tmp_path, {"depth": (1, 2)}, level_drive_time=10.0)
+    assert longer.levels["depth"][1].case.test.drive_time == 10.0 and longer.reference.case == ref
+    with pytest.raises(WheelsoilInputError, match="at least the case's test.drive_time"):
+        cv.make_study(mini, tmp_path, {"depth": (1, 2)}, level_drive_time=0.5 * ref.test.drive_time)
     assert study.levels["depth"][1].case.soil.depth == pytest.approx(2 * ref.soil.depth)
     assert study.levels["mesh"][1].case.wheel.element_size == pytest.approx(0.5 * ref.wheel.element_size)
     # the reference is one case shared by every factor; the time-step level waits for the reference's step
@@ -90,6 +96,35 @@ def test_changes_and_verdict(mini, tmp_path, monkeypatch):
     paths = cv.write_report(tight)
     text = (tmp_path / "convergence.md").read_text()
     assert "converged within 5 % from scale 0.8 on" in text and all(p.is_file() for p in paths)
+    # a level that is not steady makes the verdict undecided, not "not converged"
+    steady[0.64] = False
+    cv.write_report(study)
+    text = (tmp_path / "convergence.md").read_text()
+    assert "particle_size: **undecided**: the level(s) at scale 0.64 did not reach a steady state" in text
+    assert "depth: converged within 10 % from scale 1 on" in text
+
+
+def test_plan_estimates_particles_and_soil_cost(mini, tmp_path):
+    """Particles scale as the bin volume over the mean sphere volume, the soil's cost per simulated second as
+    particles x steps (the stable step is proportional to the particle size): x 0.8 in size is 1/0.8^4."""
+    study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8), "width": (1, 2)}, reference_time_step=2e-5)
+    rows = {(r["factor"], r["scale"]): r for r in cv.plan(study)}
+    spec = mini.bed_spec()
+    assert rows["particle_size", 1.0]["particles"] == round(0.6 * 0.6 * 0.25 * 0.05 / spec.mean_particle_volume)
+    assert rows["particle_size", 0.8]["relative_soil_cost"] == pytest.approx(0.8**-4)
+    assert rows["width", 2.0]["relative_soil_cost"] == pytest.approx(2.0)
+    assert rows["width", 2.0]["drive_time"] == 2 * mini.test.drive_time
+
+
+def test_time_step_levels_join_the_first_sweep_once_the_reference_has_run(mini, tmp_path, monkeypatch):
+    study = cv.make_study(mini, tmp_path, {"time_step": (1, 0.5)})
+    assert not cv.resolve_time_step_levels(study) and study.levels["time_step"][1].case is None
+    ref = study.reference.folder
+    ref.mkdir(parents=True)
+    (ref / cv.RESULT_NAME).write_bytes(b"")
+    monkeypatch.setattr(cv, "load_result", lambda path: type("R", (), {"info": {"dem_time_step": 4e-5}})())
+    assert cv.resolve_time_step_levels(study)
+    assert study.levels["time_step"][1].case.soil.time_step == pytest.approx(2e-5)
 
 
 def test_unrun_levels_are_reported_as_such(mini, tmp_path):
