@@ -318,7 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def cmd_validate(args) -> int:
     if args.data == "synthetic-periodic":
-        from wheelsoil.validation.oscillation import synthetic_periodic_report
+        from wheelsoil.validation.synthetic_periodic import synthetic_periodic_report
 
         command = "wheelsoil " + " ".join(args.argv)
         out = synthetic_periodic_report(args.hidden, seed=args.seed, report=args.report, command=command)
@@ -336,8 +336,15 @@ def cmd_validate(args) -> int:
     if args.periodic:
         from wheelsoil.validation.periodic import periodic_report
 
+        from .results import load_result
+
         command = "wheelsoil " + " ".join(args.argv)
-        out = periodic_report(args.data, args.periodic, report=args.report, command=command)
+        folder = Path(args.data)
+        paths = sorted((folder / "cases").glob("*/result.h5"))
+        if not paths:
+            raise _InputError(f"{folder} holds no finished runs (cases/*/result.h5); run 'wheelsoil batch' first")
+        out = periodic_report([load_result(p) for p in paths], args.periodic, source=folder.name,
+                              report=args.report, command=command)
         console = _console()
         for r in out["runs"]:
             console.print(f"  {r['case']}: f = {r['frequency_hz']:.2f} Hz, p = {r['p_value']:.1e}, "
@@ -574,7 +581,7 @@ def _torsion_tests(geometry, mesh, args, out, console) -> dict:
 
     import numpy as np
 
-    from wheelsoil.flexwheel.torsion import torsion_test, tread_nodes
+    from wheelsoil.flexwheel.torsion import torsion_test
     from wheelsoil.provenance import atomic_output
 
     if not (0 < args.max_twist <= 45):

@@ -38,7 +38,6 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output

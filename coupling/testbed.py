@@ -60,7 +60,6 @@ from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed, BedSpec, check_memory
 from wheelsoil.granular.materials import SOIL_STEEL, PairProperties
-from wheelsoil.granular.timestep import estimate_time_step
 
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
@@ -480,7 +479,7 @@ class Testbed:
         return self._advance_phase(row)
 
     def _measure(self, phase: str, interval: float) -> dict:
-        s, loop, rows = self.spec, self._loop, self.rows
+        s, loop = self.spec, self._loop
         force, moment, _ = self.contact.mean_resultant(reset=True)
         hub = self.structure.hub_position
         vel = self.structure.hub_velocity

@@ -115,7 +115,7 @@ class _FakeResult:
         self.series = {"t": t, "torque": y}
 
 
-def test_runs_from_results_take_the_drive_and_name_grouser_passing_in_red_noise():
+def test_runs_from_results_take_the_drive_and_name_grouser_passing_in_red_noise(tmp_path):
     from wheelsoil.cases.schema import load_case
     from wheelsoil.validation.periodic import runs_from_results, wheel_counts
 
@@ -138,6 +138,14 @@ def test_runs_from_results_take_the_drive_and_name_grouser_passing_in_red_noise(
     assert found["found"] == "grouser_passing", found
     with pytest.raises(WheelsoilInputError, match="has no series 'drawbar_pull'"):
         runs_from_results(results, "drawbar_pull")
+    # the report takes the results the caller read (validation does not read result files itself)
+    from wheelsoil.validation.periodic import periodic_report
+
+    out = periodic_report(results, "torque", source="six fake runs", report=tmp_path)
+    assert out["configurations"]["flexible wheel, 1g, W = 3000 N"]["found"] == "grouser_passing"
+    assert "in six fake runs" in (tmp_path / "periodic.md").read_text()
+    with pytest.raises(WheelsoilInputError, match="no finished runs"):
+        periodic_report([], source="an empty folder")
 
 
 def test_a_constant_frequency_at_one_wheel_speed_is_not_named():
@@ -165,3 +173,12 @@ def test_a_fitted_law_needs_spare_runs():
     assert explain_frequencies(runs([0.1, 0.4, 0.7]), grousers=24)["found"] is None
     slips = np.linspace(0.1, 0.7, 2 + SPARE_RUNS)
     assert explain_frequencies(runs(slips), grousers=24)["found"] == "slip_density_wave"
+
+
+def test_cli_periodic_report_of_a_folder_without_runs_is_an_input_error(tmp_path, capsys):
+    from wheelsoil.cases.cli import EXIT_INPUT, main
+
+    (tmp_path / "cases").mkdir()
+    assert main(["validate", str(tmp_path), "--periodic", "torque"]) == EXIT_INPUT
+    err = capsys.readouterr().err
+    assert "holds no finished runs" in err and "Traceback" not in err

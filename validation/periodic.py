@@ -22,13 +22,16 @@ about each law, with BIC charging the fitted laws for their parameters: each mus
 by :data:`BIC_MARGIN`.
 """
 
+import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import periodogram
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.provenance import atomic_output
 
 #: p-value below which a periodogram peak counts as a periodic component.
 SIGNIFICANCE = 1e-3
@@ -267,24 +270,22 @@ def rig_configuration(case) -> str:
     return f"{'rigid' if case.wheel.rigid else 'flexible'} wheel, {gname}, W = {case.test.load:g} N"
 
 
-def periodic_report(folder, quantity: str = "torque", *, report=None, command: str = "") -> dict:
-    """Dominant components of ``quantity`` over the finished runs of a sweep folder and, for each rig
-    configuration (wheel kind, gravity, load: :func:`rig_configuration`), the frequency law that explains
-    them; a markdown + JSON report in ``report`` (if given)."""
-    import json
-    from pathlib import Path
+def periodic_report(results, quantity: str = "torque", *, source: str = "the runs", report=None,
+                    command: str = "") -> dict:
+    """Dominant components of ``quantity`` over finished runs and, for each rig configuration (wheel kind,
+    gravity, load: :func:`rig_configuration`), the frequency law that explains them; a markdown + JSON report in
+    ``report`` (if given).
 
-    from wheelsoil.cases.results import load_result
-    from wheelsoil.provenance import atomic_output
-
-    folder = Path(folder)
-    paths = sorted((folder / "cases").glob("*/result.h5"))
-    if not paths:
-        raise WheelsoilInputError(f"{folder} holds no finished runs (cases/*/result.h5); run 'wheelsoil batch' first")
-    results = [load_result(p) for p in paths]
+    results: finished runs as read by the caller (``wheelsoil.cases.results.load_result``): each with ``case``
+    (its case file: ``wheel_geometry()``, ``wheel.rigid``, ``soil.gravity_vector``, ``test``), ``info`` and
+    ``series``, as :func:`runs_from_results` reads them; source: what they are, for titles and errors (e.g. the
+    sweep folder). Validation reads results through this interface and does not import the case layer."""
+    results = list(results)
+    if not results:
+        raise WheelsoilInputError(f"{source} holds no finished runs; run 'wheelsoil batch' first")
     wheels = {wheel_counts(r.case.wheel_geometry()) for r in results}
     if len(wheels) != 1:
-        raise WheelsoilInputError(f"the runs in {folder} use different wheels {sorted(wheels)}; the frequency laws "
+        raise WheelsoilInputError(f"{source} use different wheels {sorted(wheels)}; the frequency laws "
                                   "compare runs of one wheel")
     grousers, spokes = wheels.pop()
     runs = runs_from_results(results, quantity)
@@ -305,7 +306,7 @@ def periodic_report(folder, quantity: str = "torque", *, report=None, command: s
         report.mkdir(parents=True, exist_ok=True)
         with atomic_output(report / "periodic.json") as tmp:
             tmp.write_text(json.dumps(out, indent=1))
-        lines = [f"# Periodic components of {quantity} in {folder.name}", ""]
+        lines = [f"# Periodic components of {quantity} in {source}", ""]
         if command:
             lines += [f"Reproduce: `{command}`", ""]
         lines += [f"Dominant component of each run's {quantity} over its drive (after the spin-up), tested against "

@@ -10,6 +10,7 @@ import numpy as np
 
 from .extensions import BASELINE_OFF
 from .measured import Measurements
+from .oscillation import SeriesRecord, density_wave_amplitudes, spoke_radius_waveform
 from .terramechanics import RigidWheel, SoilParameters, predict
 
 #: The classical soil the synthetic data start from (dry sand, SI): every extension off.
@@ -144,7 +145,6 @@ def synthetic_oscillation_series(hidden: str | None, params: dict, rng: np.rando
     ``soil`` is the steady truth; the spoke-radius set uses it with a surrogate radius of 1.5 r.
     Returns :class:`~wheelsoil.validation.oscillation.SeriesRecord` objects grouped by load.
     """
-    from .oscillation import SeriesRecord, density_wave_amplitudes, spoke_radius_waveform
 
     cond = cond or oscillation_conditions()
     steady_cond = {k: cond[k] for k in ("slip", "slip_angle", "load", "gravity")}
