@@ -35,3 +35,17 @@ def test_missing_figure_is_reported():
     del now["figures"]["dem_wall_s_per_simulated_s"]
     assert compare(now, base, 0.5) == ["dem_wall_s_per_simulated_s: in the baseline but not measured now"]
 
+
+
+def test_bench_command_runs_the_tier_in_its_own_process_and_passes_its_status(tmp_path, capsys):
+    """'wheelsoil bench' hands over to python -m wheelsoil.benchmarks.smoke: a missing baseline is refused
+    there, before any timing, and its status 2 is the command's."""
+    import subprocess
+    import sys
+
+    from wheelsoil.cases.cli import main
+
+    assert main(["bench", "--smoke", "--baseline", str(tmp_path / "missing.json")]) == 2
+    done = subprocess.run([sys.executable, "-c", "import sys, wheelsoil.cases.cli; "
+                           "sys.exit(any(m.startswith('wheelsoil.benchmarks') for m in sys.modules))"])
+    assert done.returncode == 0  # the case layer does not import the benchmarks
