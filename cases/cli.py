@@ -317,6 +317,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_validate(args) -> int:
+    from wheelsoil.provenance import writable_folder
+
+    if args.report is not None:
+        writable_folder(args.report, "--report")  # before any fitting
     if args.data == "synthetic-periodic":
         from wheelsoil.validation.synthetic_periodic import synthetic_periodic_report
 
@@ -736,6 +740,8 @@ def cmd_render(args) -> int:
             raise _InputError(f"{path} is not an HDF5 file (a result or a bed)") from None
     size = tuple(args.size)
     if is_result:
+        from wheelsoil.provenance import writable_file
+
         from .render import render_animation, render_result_frame
         from .results import load_result
 
@@ -745,24 +751,26 @@ def cmd_render(args) -> int:
             out = args.out or path.parent / "animation.gif"
             if out.suffix.lower() not in (".gif", ".mp4"):
                 raise _InputError(f"--out {out}: an animation is a .gif or .mp4 file")
+            writable_file(out)
             with _progress(console) as bar:
                 task = bar.add_task("rendering frames", total=len(result.frame_times))
                 render_animation(result, out, fps=args.fps, color=args.color, wheel_color=wheel, camera=args.camera,
                                  size=size, progress=lambda k, n: bar.update(task, completed=k))
         else:
-            out = args.out or path.parent / "frame.png"
+            out = writable_file(args.out or path.parent / "frame.png")
             render_result_frame(result, out, frame=args.frame, color=args.color, wheel_color=wheel,
                                 camera=args.camera, size=size)
         console.print(f"wrote {out}")
         return EXIT_OK
     if args.animate:
         raise _InputError(f"--animate needs a result file; {path} is not one")
+    from wheelsoil.provenance import writable_file
     from wheelsoil.granular import load_bed
 
     from .render import render_bed
 
+    out = writable_file(args.out or path.with_suffix(".png"))
     bed = load_bed(path)
-    out = args.out or path.with_suffix(".png")
     console.print(f"wrote {render_bed(bed, out, camera=args.camera, size=size)}")
     return EXIT_OK
 

@@ -40,6 +40,7 @@ from pathlib import Path
 
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.granular.bed import estimated_particles
 from wheelsoil.provenance import atomic_output
 
 from .results import load_result
@@ -99,15 +100,15 @@ class ConvergenceStudy:
 
 
 def plan(study: ConvergenceStudy) -> list[dict]:
-    """Before anything runs: each level's estimated particle count (0.6 of the bin volume over the mean sphere
-    volume) and the soil's cost per simulated second relative to the reference (particles x steps per second;
+    """Before anything runs: each level's estimated particle count (:func:`~wheelsoil.granular.bed.
+    estimated_particles`) and the soil's cost per simulated second relative to the reference (particles x steps per second;
     the stable DEM step is proportional to the smallest radius, and a time-step level's step is its scale)."""
     ref = study.base.bed_spec()
-    n_ref = 0.6 * ref.length * ref.width * ref.depth / ref.mean_particle_volume
+    n_ref = estimated_particles(ref)
     out = []
     for lv in study.cases() + [lv for lvs in study.levels.values() for lv in lvs if lv.case is None]:
         spec = (lv.case or study.base).bed_spec()
-        n = 0.6 * spec.length * spec.width * spec.depth / spec.mean_particle_volume
+        n = estimated_particles(spec)
         steps = ref.diameter_min / spec.diameter_min / (lv.scale if lv.factor == "time_step" else 1.0)
         out.append({"factor": lv.factor, "scale": lv.scale, "particles": int(round(n)),
                     "relative_soil_cost": n / n_ref * steps,

@@ -26,7 +26,9 @@ import numpy as np
 
 from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.provenance import atomic_output, provenance
+from wheelsoil.flexwheel.geometry import estimated_elements
+from wheelsoil.granular.bed import estimated_particles
+from wheelsoil.provenance import atomic_output, provenance, writable_folder
 
 from .results import ResultWriter, attr_value, partial_path
 from .schema import CaseFile, case_to_toml
@@ -81,6 +83,19 @@ def load_checkpoint(path: Path) -> tuple[dict, dict]:
 
 
 # -------------------------------------------------------------------- the run
+def output_bytes(case: CaseFile) -> int:
+    """Upper estimate of a run's files [bytes]: its frames (at most one per sample; per particle position,
+    velocity and radius, per wheel element about a node's position and deformation, 8 bytes each) over the
+    longest run (lowering allowed 2 s, settle, spin-up, the whole drive), plus two checkpoints."""
+    t = case.test
+    total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
+    o = case.output
+    frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
+    particles = estimated_particles(case.bed_spec())
+    per_frame = particles * 7 * 8 + estimated_elements(case.wheel_geometry()) * 6 * 8
+    return frames * per_frame + 2 * particles * 30 * 8
+
+
 def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume: bool = False,
              restart: bool = False, progress: bool = False, console=None,
              bed_cache: str | Path | None = None) -> RunOutcome:
@@ -98,7 +113,7 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     from wheelsoil.granular import prepare_bed
 
     say = console.print if console is not None else (lambda *a, **k: None)
-    out = Path(out)
+    out = writable_folder(out, "--out", need_bytes=output_bytes(case))
     result_path = out / RESULT_NAME
     ckpt_path = out / CHECKPOINT_NAME
     case_hash = case.case_hash()

@@ -91,7 +91,8 @@ class Soil(_Section):
     gravity: Union[float, tuple[float, float, float], str] = Field(
         "earth", description="'earth' (9.81 m/s^2), 'moon' (9.81/6), a magnitude in m/s^2, or a vector "
                              "[gx, gy, gz] with gz < 0; the bed is prepared under the gravity it is tested at")
-    youngs_modulus: float = _q(50e6, "Pa", "particle Young's modulus (seed 004 Table 1)", gt=0)
+    youngs_modulus: float = _q(50e6, "Pa", "particle Young's modulus (seed 004 Table 1); at most 1.2e12 Pa "
+                                           "(diamond)", gt=0, le=1.2e12)
     poisson_ratio: float = _q(0.3, "1", "particle Poisson's ratio", gt=-1, lt=0.5)
     density: float = _q(3200.0, "kg/m^3", "particle density", gt=0)
     restitution: float = _q(0.5, "1", "soil--soil coefficient of restitution", gt=0, le=1)
@@ -157,7 +158,8 @@ class Wheel(_Section):
     grouser_thickness: Optional[float] = _q(None, "m", "grouser sheet thickness", ge=0)
     grouser_angle: Optional[float] = _q(None, "deg", "grouser angle to the axle (chevron half-angle)")
     hub_mass: Optional[float] = _q(None, "kg", "hub mass (with the rig's moving parts)", ge=0)
-    youngs_modulus: Optional[float] = _q(None, "Pa", "wheel material Young's modulus", gt=0)
+    youngs_modulus: Optional[float] = _q(None, "Pa", "wheel material Young's modulus; at most 1.2e12 Pa (diamond)",
+                                         gt=0, le=1.2e12)
     poisson_ratio: Optional[float] = _q(None, "1", "wheel material Poisson's ratio", gt=-1, lt=0.5)
     density: Optional[float] = _q(None, "kg/m^3", "wheel material density", gt=0)
 
@@ -307,6 +309,17 @@ def preset_text(name: str) -> str:
     return path.read_text()
 
 
+def read_toml_text(path: Path) -> str:
+    """The text of a TOML file; a file that is not UTF-8 text or cannot be read is a :class:`CaseError`."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise CaseError(str(path), [f"not a TOML text file (not UTF-8 text: byte {exc.start} is "
+                                    f"{exc.object[exc.start:exc.start + 1]!r})"]) from None
+    except OSError as exc:
+        raise CaseError(str(path), [f"cannot be read: {exc.strerror or exc}"]) from None
+
+
 def parse_toml(text: str, source: str) -> dict:
     try:
         return tomllib.loads(text)
@@ -388,6 +401,14 @@ def validate_case(data: dict, source: str, *, default_name: str | None = None) -
     if case.case.name is None:
         name = default_name or "case"
         case = case.model_copy(update={"case": case.case.model_copy(update={"name": name})})
+    o = case.output
+    for key in ("frame_interval", "checkpoint_interval"):
+        value = getattr(o, key)
+        if 0 < value < o.sample_interval:
+            raise CaseError(source, [f"output.{key} = {value:g} s is shorter than output.sample_interval = "
+                                     f"{o.sample_interval:g} s (they are taken at the ends of samples): use 0 "
+                                     f"({'the last frame only' if key == 'frame_interval' else 'none'}) or at least "
+                                     f"{o.sample_interval:g} s"])
     try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, the drive, ...)
         from wheelsoil.coupling.testbed import check_fits
 
@@ -437,7 +458,7 @@ def load_case(spec: str | Path, overrides=(), *, name: str | None = None) -> Cas
     if path.suffix == ".toml" or path.is_file():
         if not path.is_file():
             raise CaseError(str(path), ["no such case file"])
-        text, source, stem = path.read_text(), str(path), path.stem
+        text, source, stem = read_toml_text(path), str(path), path.stem
     else:
         text, source, stem = preset_text(str(spec)), f"preset {spec}", str(spec)
     data = apply_overrides(parse_toml(text, source), [o for o in overrides])

@@ -48,7 +48,8 @@ from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output
 
 from .run import RESULT_NAME
-from .schema import CaseError, CaseFile, apply_overrides, case_to_toml, load_case, parse_toml, validate_case
+from .schema import (CaseError, CaseFile, apply_overrides, case_to_toml, load_case, parse_toml, read_toml_text,
+                     validate_case)
 
 
 class SweepSpec(BaseModel):
@@ -118,7 +119,7 @@ def load_sweep(path: str | Path, out: str | Path | None = None) -> Sweep:
             raise WheelsoilInputError(f"sweep file {source!r} does not exist")
         text, source, stem, base_dir = packaged.read_text(), f"sweep preset {path.name}", path.name, Path.cwd()
     else:
-        text, stem, base_dir = path.read_text(), path.stem, path.parent
+        text, stem, base_dir = read_toml_text(path), path.stem, path.parent
     data = parse_toml(text, source)
     if set(data) != {"sweep"}:
         raise CaseError(source, [f"a sweep file has one table, [sweep]; found {sorted(data)}"])

@@ -55,11 +55,12 @@ from pathlib import Path
 import numpy as np
 
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
-from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh
+from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, check_mesh_memory
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
-from wheelsoil.granular.bed import Bed, BedSpec, check_memory
+from wheelsoil.granular.bed import Bed, BedSpec, check_memory, machine_memory
 from wheelsoil.granular.materials import SOIL_STEEL, PairProperties
+from wheelsoil.granular.timestep import estimate_time_step
 
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
@@ -259,6 +260,24 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     patch on a periodic bin) holds the drive, before any bed is prepared; returns the hub's start position along the bin [m]. The errors name the case keys
     and values."""
     check_memory(bed)
+    check_mesh_memory(wheel, machine_memory())
+    if spec.time_step is not None:
+        # the soil pairs alone bound the stable step from above (walls and the wheel only shorten it): a step
+        # beyond it is refused now, not after the bed is prepared
+        est = estimate_time_step(0.5 * bed.diameter_min, bed.material)
+        if spec.time_step > est.stable:
+            raise WheelsoilInputError(f"soil.time_step = {spec.time_step:.3g} s exceeds the stable time step of "
+                                      f"the particle pairs: {est.describe()}")
+    pressure = spec.load / (wheel.width * wheel.radius)
+    if pressure > 0.05 * bed.material.youngs_modulus:
+        # a nominal pressure p over a contact of about one radius: Hertz overlaps grow as (p / E)^(2/3) of the
+        # radius, past ~10 % when p > 5 % of E -- beyond what a soft-sphere contact model represents
+        raise WheelsoilInputError(
+            f"test.load = {spec.load:.4g} N on a wheel of width {wheel.width:g} m and radius {wheel.radius:g} m is a "
+            f"nominal pressure W / (b r) = {pressure:.3g} Pa, more than 5 % of the soil's Young's modulus "
+            f"({bed.material.youngs_modulus:.3g} Pa): the particles would overlap by more than about a tenth of "
+            f"their radius; lower the load (at most {0.05 * bed.material.youngs_modulus * wheel.width * wheel.radius:.3g} N)"
+            " or stiffen the soil (soil.youngs_modulus)")
     beta = math.radians(spec.slip_angle)
     outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
     # footprint across the bin: the width turned by beta plus a contact length of about one radius
@@ -365,6 +384,9 @@ class Testbed:
             # tests the same bed)
             self.scene.time_step = spec.time_step
         self.dt = self.scene.time_step
+        if spec.sample_interval < self.dt:
+            raise WheelsoilInputError(f"output.sample_interval = {spec.sample_interval:.3g} s is shorter than the "
+                                      f"run's DEM step {self.dt:.3g} s: a sample averages at least one step")
         self.steps_per_sample = max(1, int(round(spec.sample_interval / self.dt)))
         self.structure.drive_hub(velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                                  free_translation=(False, False, False), free_rotation=(False, False, False))

@@ -120,6 +120,42 @@ class WheelGeometry:
         return self.radius - 0.5 * self.tread_thickness
 
 
+#: Peak resident memory per wheel element while a wheel is meshed, assembled and stepped [bytes]: an upper
+#: bound, about 2.5 x the 6.6 KiB per element measured for the 25,920-element seed-004 wheel (281 MiB less the
+#: 110 MiB interpreter; benchmarks/README.md, testbed throughput).
+BYTES_PER_ELEMENT = 16384
+
+
+def estimated_elements(g: WheelGeometry) -> int:
+    """Elements (triangles and beams) :func:`build_wheel_mesh` makes, from the grid counts alone (without the
+    round-up that puts nodes at every spoke and grouser angle: 10-50 % low on the presets); O(1) in the count."""
+    h = g.element_size
+    n_around = math.ceil(2 * math.pi * g.tread_mid_radius / h)
+    n_width = max(2, math.ceil(g.width / h))
+    n = 2 * n_around * n_width
+    if g.grouser_count:
+        n += g.grouser_count * 2 * max(1, math.ceil(g.grouser_height / h)) * n_width
+    n_s = max(2, math.ceil((g.tread_mid_radius - g.hub_radius) * (1 + 2 * g.spoke_bow) / h))
+    for row in g.spoke_rows:
+        cols = max(1, round((row.y_max - row.y_min) * n_width))
+        n += g.spokes_per_row * (2 * n_s * cols if g.spoke_model == "shell" else n_s * (cols + 1))
+    return int(n)
+
+
+def check_mesh_memory(g: WheelGeometry, available: int, share: float = 0.5) -> int:
+    """Refuse, before meshing, a wheel whose estimated elements need more than ``share`` of ``available``
+    bytes (:data:`BYTES_PER_ELEMENT` each); returns the estimate [bytes]."""
+    n = estimated_elements(g)
+    need = n * BYTES_PER_ELEMENT
+    if available > 0 and need > share * available:
+        raise WheelsoilInputError(
+            f"wheel {g.name!r}: wheel.element_size = {g.element_size:g} m makes about {n:,} elements, about "
+            f"{need / 2**30:.3g} GiB, more than {share:.0%} of the {available / 2**30:.3g} GiB this machine has: "
+            f"use a coarser element_size (the preset's own is a good start)"
+        )
+    return need
+
+
 def _grid_count(fractions: list[float], start: int, period: float = 1.0) -> int:
     """Smallest n >= start for which every fraction (of ``period``) is a multiple of period / n."""
     for n in range(max(start, 1), 100_000):

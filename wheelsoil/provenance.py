@@ -2,6 +2,8 @@
 
 * :func:`atomic_output` -- write to a temporary sibling and rename only when complete, so a crashed
   or killed run never leaves a file that looks finished.
+* :func:`writable_folder`, :func:`writable_file` -- check (and make) an output place before any work, so a
+  bad ``--out`` is an input error naming it and not a traceback after minutes of simulation.
 * :func:`provenance` -- the versions and revision every result file carries.
 """
 
@@ -11,7 +13,10 @@ import contextlib
 import datetime as _dt
 import os
 import subprocess
+import tempfile
 from pathlib import Path
+
+from .errors import WheelsoilInputError
 
 
 @contextlib.contextmanager
@@ -29,6 +34,38 @@ def atomic_output(path: str | os.PathLike):
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def writable_folder(path: str | os.PathLike, what: str = "--out", *, need_bytes: int = 0) -> Path:
+    """Make the folder ``path`` (with its parents) and check that a file can be written in it and, when
+    ``need_bytes`` is given, that its disk has that much free; returns it. Errors name ``what`` and the path."""
+    folder = Path(path)
+    for parent in [folder, *folder.parents]:
+        if parent.exists():
+            if not parent.is_dir():
+                raise WheelsoilInputError(f"{what} {str(folder)!r}: {str(parent)!r} is a file, not a folder")
+            break
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise WheelsoilInputError(f"{what} {str(folder)!r} cannot be written: {exc.strerror or exc}") from None
+    if need_bytes > 0:
+        free = os.statvfs(folder).f_bavail * os.statvfs(folder).f_frsize if hasattr(os, "statvfs") else 0
+        if free and need_bytes > free:
+            raise WheelsoilInputError(f"{what} {str(folder)!r}: the output needs about {need_bytes / 2**30:.3g} GiB "
+                                      f"and its disk has {free / 2**30:.3g} GiB free")
+    return folder
+
+
+def writable_file(path: str | os.PathLike, what: str = "--out") -> Path:
+    """Check that the file ``path`` can be written (its folder made and writable, the path not a folder)."""
+    target = Path(path)
+    if target.is_dir():
+        raise WheelsoilInputError(f"{what} {str(target)!r} is a folder; give a file name")
+    writable_folder(target.parent, f"{what} {str(target)!r}: its folder")
+    return target
 
 
 def git_revision() -> str | None:

@@ -72,6 +72,13 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
         kwargs["cpu_max_num_threads"] = int(cpu_threads)
     t0 = time.perf_counter()
     ti.init(**kwargs)
+    actual = ti.lang.impl.current_cfg().arch
+    if requested != "cpu" and actual in (ti.x64, ti.arm64):
+        # Taichi falls back to the CPU with a log line; a user who asked for a device is told plainly instead
+        raise WheelsoilInputError(
+            f"arch={requested!r}: no {requested} device is usable on this machine (Taichi would fall back to "
+            f"the CPU, {actual.name}); use --arch cpu, or run where the device and its driver are installed"
+        )
     _state["init_seconds"] = time.perf_counter() - t0
     _state["arch"] = requested
     return requested

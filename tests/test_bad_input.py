@@ -1,0 +1,72 @@
+"""Bad input from the command line is a clean error before any work: exit status 2, a message naming the key
+or path, its value and what is allowed, and no traceback (issue 19's list: binary case files, output places
+that cannot be written, physically impossible or machine-breaking values, frames finer than samples)."""
+
+import pytest
+
+from wheelsoil.cases.cli import EXIT_INPUT, main
+
+MEASURED = "../shared/data/measured/cmu_3d_terramechanics"
+
+
+@pytest.fixture()
+def a_file(tmp_path):
+    path = tmp_path / "a-file"
+    path.write_text("not a folder\n")
+    return path
+
+
+def _refused(argv, capsys, *needles):
+    assert main(argv) == EXIT_INPUT
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+def test_a_binary_case_or_sweep_file(tmp_path, capsys):
+    garbage = tmp_path / "garbage.toml"
+    garbage.write_bytes(b"\x89PNG\r\n\x1a\n\x00\xff binary")
+    _refused(["case", "check", str(garbage)], capsys, "garbage.toml", "not a TOML text file")
+    _refused(["batch", str(garbage), "--out", str(tmp_path / "sweep")], capsys, "not a TOML text file")
+
+
+@pytest.mark.parametrize("where", ["under-a-file", "a-file", "proc"])
+def test_an_output_folder_that_cannot_be_written(where, a_file, tmp_path, capsys):
+    out = {"under-a-file": a_file / "sub", "a-file": a_file, "proc": "/proc/wheelsoil-test"}[where]
+    _refused(["run", "mini-1g-steer", "--out", str(out)], capsys, "--out", str(out))
+
+
+@pytest.mark.parametrize("override, needles", [
+    ("soil.youngs_modulus=1e15", ["soil.youngs_modulus", "1.2e+12"]),
+    ("wheel.youngs_modulus=1e13", ["wheel.youngs_modulus", "1.2e+12"]),
+    ("test.load=1e9", ["test.load = 1e+09 N", "at most"]),
+    ("output.frame_interval=1e-9", ["output.frame_interval = 1e-09 s", "output.sample_interval"]),
+    ("output.checkpoint_interval=1e-4", ["output.checkpoint_interval", "output.sample_interval"]),
+    ("wheel.element_size=1e-5", ["wheel.element_size = 1e-05 m", "GiB"]),
+    ("soil.diameter_min=0.001", ["soil.diameter_min", "GiB"]),
+    ("soil.time_step=1e-2", ["soil.time_step = 0.01 s exceeds the stable time step"]),
+])
+def test_values_a_run_cannot_survive_are_refused_by_case_check(override, needles, capsys):
+    big = override.startswith("soil.diameter_min")  # 1-1.5 mm in the smoke bin: ~2e8 spheres, ~900 GiB
+    extra = ["--set", "soil.diameter_max=0.0015"] if big else []
+    _refused(["case", "check", "smoke-1g-steer" if big else "mini-1g-steer", "--set", override, *extra], capsys,
+             *needles)
+
+
+def test_a_sample_shorter_than_the_dem_step_is_refused_before_the_drive(tmp_path, capsys):
+    _refused(["run", "mini-1g-steer", "--set", "output.sample_interval=1e-12", "--set", "output.frame_interval=0",
+              "--set", "output.checkpoint_interval=0", "--out", str(tmp_path / "run")], capsys,
+             "output.sample_interval = 1e-12 s is shorter than the run's DEM step")
+
+
+def test_render_and_report_places_are_checked_before_work(tmp_path, a_file, capsys):
+    from wheelsoil.granular import BedSpec, prepare_bed
+
+    bed = prepare_bed(BedSpec(length=0.2, width=0.1, depth=0.03, diameter_min=0.01, diameter_max=0.012),
+                      cache_dir=tmp_path / "cache")
+    path = bed.save(tmp_path / "bed.h5")
+    _refused(["render", str(path), "--out", str(tmp_path)], capsys, "is a folder; give a file name")
+    _refused(["render", str(path), "--out", str(a_file / "x.png")], capsys, "is a file, not a folder")
+    _refused(["validate", MEASURED, "--report", str(a_file / "report")], capsys, "--report", "is a file")
