@@ -6,9 +6,6 @@ import pytest
 
 from wheelsoil.cases.cli import EXIT_INPUT, main
 
-MEASURED = "../shared/data/measured/cmu_3d_terramechanics"
-
-
 @pytest.fixture()
 def a_file(tmp_path):
     path = tmp_path / "a-file"
@@ -62,6 +59,7 @@ def test_a_sample_shorter_than_the_dem_step_is_refused_before_the_drive(tmp_path
 
 
 def test_render_and_report_places_are_checked_before_work(tmp_path, a_file, capsys):
+    """The report folder is checked before the data are even read (the data path need not exist)."""
     from wheelsoil.granular import BedSpec, prepare_bed
 
     bed = prepare_bed(BedSpec(length=0.2, width=0.1, depth=0.03, diameter_min=0.01, diameter_max=0.012),
@@ -69,4 +67,31 @@ def test_render_and_report_places_are_checked_before_work(tmp_path, a_file, caps
     path = bed.save(tmp_path / "bed.h5")
     _refused(["render", str(path), "--out", str(tmp_path)], capsys, "is a folder; give a file name")
     _refused(["render", str(path), "--out", str(a_file / "x.png")], capsys, "is a file, not a folder")
-    _refused(["validate", MEASURED, "--report", str(a_file / "report")], capsys, "--report", "is a file")
+    _refused(["validate", str(tmp_path / "no-data.csv"), "--report", str(a_file / "report")], capsys, "--report",
+             "is a file")
+
+
+@pytest.mark.parametrize("change, needle", [
+    ("drop-responses", "no measured response in any row"),
+    ("text-slip", "the condition 'slip' must be a number in every row; data row 4 holds 'abc'"),
+    ("negative-loads", "no row to fit: 27 of 27 rows lie outside the model's domain"),
+    ("missing-load", "the condition 'load' is missing (empty or NaN) in data row(s) [3]"),
+])
+def test_measured_files_the_model_cannot_use(change, needle, measured_dir, tmp_path, capsys):
+    import os
+
+    import pandas as pd
+
+    data = pd.read_csv(os.path.join(measured_dir, "digitised_single_wheel", "single_wheel_experiments.csv"))
+    if change == "drop-responses":
+        data = data.drop(columns=["meas_drawbar_pull_n", "meas_torque_nm", "meas_sinkage_m"])
+    elif change == "text-slip":
+        data["slip"] = data["slip"].astype(object)
+        data.loc[3, "slip"] = "abc"
+    elif change == "negative-loads":
+        data["vertical_load_n"] = -data["vertical_load_n"]
+    else:
+        data.loc[2, "vertical_load_n"] = float("nan")
+    path = tmp_path / "bad.csv"
+    data.to_csv(path, index=False)
+    _refused(["validate", str(path), "--report", str(tmp_path / "report")], capsys, needle)

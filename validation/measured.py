@@ -294,9 +294,38 @@ SIMULATED_RESPONSES = {"drawbar_pull": "drawbar_pull", "lateral_force": "lateral
                        "sinkage": "tread_sinkage", "torque": "torque"}
 
 
+#: The conditions every row needs as numbers.
+CONDITIONS = ("slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count")
+
+
+def check_measurements(data: Measurements, source) -> Measurements:
+    """Refuse a dataset the model cannot be fitted to, naming the file, column and rows: a condition that
+    holds text or is missing in some rows, or no measured response at all."""
+    for key in CONDITIONS:
+        values = np.asarray(getattr(data, key))
+        if values.dtype.kind not in "fiu":
+            bad = [(k, v) for k, v in enumerate(values) if not _is_float(str(v))]
+            k, v = bad[0][0], str(bad[0][1])
+            raise WheelsoilInputError(f"{source}: the condition {key!r} must be a number in every row; data row "
+                                      f"{k + 1} holds {v!r} ({len(bad)} such row(s))")
+        missing = np.flatnonzero(~np.isfinite(values.astype(float)))
+        if missing.size:
+            raise WheelsoilInputError(f"{source}: the condition {key!r} is missing (empty or NaN) in data row(s) "
+                                      f"{(missing + 1)[:10].tolist()}{' ...' if missing.size > 10 else ''}")
+    measured = [q for q, v in data.responses.items() if np.isfinite(np.asarray(v, float)).any()]
+    if not measured:
+        raise WheelsoilInputError(f"{source}: no measured response in any row (columns such as drawbar_pull_N, "
+                                  "lateral_force_N, sinkage_m, torque_Nm): nothing to validate against")
+    return data
+
+
 def load_measurements(path: str | Path) -> Measurements:
     """Any supported dataset: a folder of CMU trial files, a wheelsoil sweep folder or its summary.csv
-    (simulated), the digitised-points CSV, or wheelsoil's CSV format."""
+    (simulated), the digitised-points CSV, or wheelsoil's CSV format; checked by :func:`check_measurements`."""
+    return check_measurements(_load_any(path), path)
+
+
+def _load_any(path: str | Path) -> Measurements:
     path = Path(path)
     if path.is_dir():
         if (path / "grouser_wheel_trials.csv").is_file():

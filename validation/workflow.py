@@ -22,10 +22,20 @@ MAX_SLIP_ANGLE = 80.0
 def prepare(data: Measurements) -> tuple[Measurements, tuple, str]:
     """Rows the model can describe, the responses to fit, and a note of what was left out and why."""
     notes = []
-    keep = (data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) <= MAX_SLIP_ANGLE) & (data.load > 0)
-    if (~keep).any():
-        notes.append(f"{int((~keep).sum())} rows outside the model's domain (driving slip 0 <= i < 1, "
-                     f"|slip angle| <= {MAX_SLIP_ANGLE:g} deg)")
+    domain = (data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) <= MAX_SLIP_ANGLE) & (data.load > 0)
+    measured = np.any([np.isfinite(v) for v in data.responses.values()], axis=0)
+    if (~domain).any():
+        notes.append(f"{int((~domain).sum())} rows outside the model's domain (driving slip 0 <= i < 1, "
+                     f"|slip angle| <= {MAX_SLIP_ANGLE:g} deg, load > 0)")
+    if (domain & ~measured).any():
+        notes.append(f"{int((domain & ~measured).sum())} rows with no measured response (empty or NaN)")
+    keep = domain & measured
+    if not keep.any():
+        raise WheelsoilInputError(
+            f"{data.name}: no row to fit: {int((~domain).sum())} of {len(data)} rows lie outside the model's domain "
+            f"(driving slip 0 <= i < 1: {int(((data.slip >= 0) & (data.slip < 1)).sum())} rows; load > 0: "
+            f"{int((data.load > 0).sum())} rows; |slip angle| <= {MAX_SLIP_ANGLE:g} deg), "
+            f"{int((~measured).sum())} have no measured response")
     data = data.select(keep)
     responses = [q for q in RESPONSES if np.isfinite(data.responses[q]).any()]
     if data.sinkage_relative and "sinkage" in responses:
