@@ -15,9 +15,10 @@ import argparse
 import sys
 from pathlib import Path
 
+from wheelsoil.gravity import GRAVITY_PRESETS
+
 EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
-GRAVITY_PRESETS = {"earth": 9.81, "moon": 9.81 / 6.0}
 
 MAIN_HELP = """\
 wheelsoil: a single-wheel terramechanics testbed in software.

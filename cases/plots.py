@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.gravity import gravity_label
+
 
 def _pyplot():
     import matplotlib
@@ -92,7 +94,7 @@ def plot_sweep(table, out: str | Path, title: str) -> list[Path]:
                 sel = sel.sort_values("slip_set")
                 if sel.empty:
                     continue
-                gname = "1g" if abs(g - 9.81) < 0.05 else ("1/6 g" if abs(g - 9.81 / 6) < 0.05 else f"{g:.3g} m/s²")
+                gname = gravity_label(g)
                 ax.errorbar(sel["slip_set"], scale * sel[f"{column}_mean"], yerr=scale * sel[f"{column}_std"],
                             marker="os^vD"[k % 5], capsize=2,
                             label=f"{gname}, W = {w:g} N{', rigid wheel' if rigid else ''}")

@@ -33,6 +33,7 @@ from typing import Literal, Optional, Union
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.gravity import GRAVITY_PRESETS
 
 from .units import UnitError, to_unit
 
@@ -41,8 +42,6 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-EARTH_GRAVITY = 9.81
-GRAVITY_PRESETS = {"earth": EARTH_GRAVITY, "moon": EARTH_GRAVITY / 6.0}
 
 
 class CaseError(WheelsoilInputError):

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
 
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
@@ -177,7 +178,7 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
     data = Measurements(
         name="cmu_3d_terramechanics",
         slip=cols("slip"), slip_angle=cols("steering_angle"), load=cols("vertical_load"),
-        gravity=np.full(n, 9.81), radius=np.full(n, CMU_WHEEL["radius"]), width=np.full(n, CMU_WHEEL["width"]),
+        gravity=np.full(n, EARTH_GRAVITY), radius=np.full(n, CMU_WHEEL["radius"]), width=np.full(n, CMU_WHEEL["width"]),
         grouser_height=np.array([CMU_WHEEL["grouser_height"][g] for g in group]), grouser_count=np.zeros(n),
         group=group,
         responses={"drawbar_pull": cols("drawbar_pull"), "lateral_force": -cols("lateral_force"),
@@ -200,7 +201,7 @@ def load_digitised(path: str | Path) -> Measurements:
     n = len(t)
     return Measurements(
         name="digitised_single_wheel",
-        slip=t.columns["slip"], slip_angle=np.zeros(n), load=t.columns["vertical_load"], gravity=np.full(n, 9.81),
+        slip=t.columns["slip"], slip_angle=np.zeros(n), load=t.columns["vertical_load"], gravity=np.full(n, EARTH_GRAVITY),
         radius=t.columns["wheel_radius"], width=t.columns["wheel_width"],
         grouser_height=t.columns["grouser_height"], grouser_count=t.columns["grouser_count"],
         group=np.array([f"{s}:{'lug' if h > 0 else 'smooth'}" for s, h in zip(t.columns["source"],
@@ -245,7 +246,7 @@ def load_generic(path: str | Path, name: str | None = None) -> Measurements:
     get = lambda key, default: t.columns.get(key, np.full(n, default))  # noqa: E731
     return Measurements(
         name=name or Path(path).stem, slip=t.columns["slip"], slip_angle=get("slip_angle", 0.0),
-        load=t.columns["vertical_load"], gravity=get("gravity", 9.81), radius=t.columns["wheel_radius"],
+        load=t.columns["vertical_load"], gravity=get("gravity", EARTH_GRAVITY), radius=t.columns["wheel_radius"],
         width=t.columns["wheel_width"], grouser_height=get("grouser_height", 0.0), grouser_count=get("grouser_count", 0.0),
         group=t.columns["group"] if "group" in t.columns else np.full(n, "all"),
         responses={q: get(q, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
@@ -276,8 +277,7 @@ def load_sweep_summary(path: str | Path) -> Measurements:
     if missing:
         raise WheelsoilInputError(f"{path} is not a wheelsoil sweep summary: columns {missing} are missing")
     g = t["gravity"].to_numpy(float)
-    group = np.where(np.abs(g - 9.81) < 0.05, "1g", np.where(np.abs(g - 9.81 / 6) < 0.05, "moon",
-                                                             np.char.add("g", np.round(g, 3).astype(str))))
+    group = np.array([gravity_label(v, moon="moon", other="g{g:.3g}") for v in g])
     col = lambda key: t[key].to_numpy(float)  # noqa: E731
     return Measurements(
         name=path.parent.name, slip=col("slip_set"), slip_angle=col("slip_angle_set"), load=col("load_set"),

@@ -31,6 +31,7 @@ from scipy.optimize import least_squares
 from scipy.signal import periodogram
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.gravity import gravity_label
 from wheelsoil.provenance import atomic_output
 
 #: p-value below which a periodogram peak counts as a periodic component.
@@ -266,7 +267,7 @@ def wheel_counts(geometry) -> tuple[int, int]:
 def rig_configuration(case) -> str:
     """The label of what sets a run's natural modes besides the wheel speed and slip: wheel kind, gravity, load."""
     g = -case.soil.gravity_vector[2]
-    gname = "1g" if abs(g - 9.81) < 0.05 else ("moon" if abs(g - 9.81 / 6) < 0.05 else f"g={g:.3g}")
+    gname = gravity_label(g, moon="moon", other="g={g:.3g}")
     return f"{'rigid' if case.wheel.rigid else 'flexible'} wheel, {gname}, W = {case.test.load:g} N"
 
 

@@ -8,6 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from wheelsoil.gravity import EARTH_GRAVITY
+
 from .extensions import BASELINE_OFF
 from .measured import Measurements
 from .oscillation import SeriesRecord, density_wave_amplitudes, spoke_radius_waveform
@@ -37,7 +39,7 @@ HIDDEN_RANGES = {
 
 
 def conditions(slips=(0.05, 0.15, 0.3, 0.45, 0.6, 0.75), slip_angles=(0.0, 10.0, 20.0, 30.0),
-               loads=(60.0, 120.0), gravities=(9.81, 1.62), passes=(1, 2, 3)):
+               loads=(60.0, 120.0), gravities=(EARTH_GRAVITY, 1.62), passes=(1, 2, 3)):
     """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2]), each run on
     one of ``passes`` (the wheel's pass number over the same soil). The pass number cycles with the sum of the
     other factors' level indices, a balanced design in which it is not aliased with any one of them, so that
@@ -131,7 +133,7 @@ def oscillation_conditions(slips=(0.1, 0.25, 0.4, 0.55), loads=(40.0, 80.0, 160.
     through ``omegas`` [rad/s] so that a counting law can be told from a constant frequency."""
     slip, load = (a.ravel() for a in np.meshgrid(slips, loads, indexing="ij"))
     omega = np.array([omegas[k % len(omegas)] for k in range(slip.size)], float)
-    return {"slip": slip, "slip_angle": np.zeros(slip.size), "load": load, "gravity": np.full(slip.size, 9.81),
+    return {"slip": slip, "slip_angle": np.zeros(slip.size), "load": load, "gravity": np.full(slip.size, EARTH_GRAVITY),
             "omega": omega}
 
 

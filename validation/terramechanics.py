@@ -42,13 +42,11 @@ from functools import lru_cache
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.gravity import EARTH_GRAVITY
 
 #: Gauss--Legendre nodes per contact region (front and rear of theta_m); 48 integrate the smooth stress
 #: profiles to better than 1e-8 relative (see tests/test_validation_terramechanics.py).
 QUADRATURE_POINTS = 48
-#: Reference gravity of the cohesion's gravity scaling [m/s^2].
-EARTH_GRAVITY = 9.81
-
 
 def _positive(name: str, value: float, *, allow_zero: bool = False) -> None:
     ok = np.isfinite(value) and (value >= 0.0 if allow_zero else value > 0.0)
@@ -356,7 +354,7 @@ def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gr
     return fx, fz, torque
 
 
-def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=9.81, passes=1.0,
+def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=EARTH_GRAVITY, passes=1.0,
             max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10, max_iterations: int = 200) -> dict:
     """Steady-state forces and sinkage for each condition (arrays broadcast together).
 
