@@ -31,6 +31,7 @@ def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
     assert main(["validate", "synthetic", "--hidden", "slip_sinkage", "--seed", "4", "--report", str(out)]) == EXIT_OK
     findings = json.loads((out / "findings.json").read_text())
     assert findings["found"]["name"] == "slip_sinkage"
+    assert all(type(c["found"]) is bool for c in findings["candidates"])  # booleans, not 0.0
     assert "Hidden: slip_sinkage" in (out / "report.md").read_text()
     assert (out / "synthetic_data.csv").stat().st_size > 0
     capsys.readouterr()

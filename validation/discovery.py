@@ -169,7 +169,7 @@ class Candidate:
 
     @property
     def found(self) -> bool:
-        return self.delta_bic < -BIC_MARGIN and self.gain > GAIN_SIGMAS * self.gain_std and self.gain > 0
+        return bool(self.delta_bic < -BIC_MARGIN and self.gain > GAIN_SIGMAS * self.gain_std and self.gain > 0)
 
     def to_dict(self) -> dict:
         return {"name": self.extension.name, "mechanism": self.extension.mechanism, "source": self.extension.source,
