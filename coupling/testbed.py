@@ -256,9 +256,10 @@ def wheel_period(wheel: WheelGeometry) -> float:
 
 
 def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
-    """Check that the bed fits the machine's memory, that the wheel fits the bin and that the bin (or the moving
-    patch on a periodic bin) holds the drive, before any bed is prepared; returns the hub's start position along the bin [m]. The errors name the case keys
-    and values."""
+    """Check, before any bed is prepared, that the bed and the wheel mesh fit the machine's memory, that the
+    time step and the load are ones the contact model can take, that the wheel fits the bin and that the bin
+    (or the moving patch on a periodic bin) holds the drive; returns the hub's start position along the bin
+    [m]. The errors name the case keys and values."""
     check_memory(bed)
     check_mesh_memory(wheel, machine_memory())
     if spec.time_step is not None:
