@@ -58,7 +58,9 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
     t0 = time.perf_counter()
     bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
     setup = time.perf_counter() - t0
+    cpu0 = time.process_time()
     result = bench.run()
+    protocol_cpu = time.process_time() - cpu0
     info = result.info
     out = {
         "case": case.name,
@@ -69,6 +71,7 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
         "protocol_wall_seconds": info["wall_seconds"],
         "protocol_simulated_seconds": info["simulated_seconds"],
         "wall_seconds_per_simulated_second": info["seconds_per_simulated_second"],
+        "protocol_cores_busy": protocol_cpu / info["wall_seconds"],  # CPU time of all threads / wall, whole run
         "lowering_and_settling_simulated_seconds": info["t_drive_start"],
         "dem_time_step_s": info["dem_time_step"],
         "fe_time_step_s": info["fe_time_step"],
@@ -102,6 +105,19 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
         "dem_neighbor_rebuilds": scene.neighbor_rebuilds - dem_rebuilds0,
         "mean_wheel_contacts": contacts / (steps // 10),
         "peak_rss_mib": own_peak_rss_mib(),
+    })
+    # the soil alone: the same bed in the same bin at the same step, without the wheel
+    soil = bed.to_scene(headroom=max(bed.spec.depth, 0.25), arch=arch, periodic_x=False,
+                        end_walls=bench.patch is None)
+    soil.time_step = bench.dt
+    soil.step(10)  # compile
+    t0, cpu0 = time.perf_counter(), time.process_time()
+    soil.step(n)
+    soil_total = time.perf_counter() - t0
+    out.update({
+        "ms_per_step_soil_alone": 1e3 * soil_total / n,
+        "soil_alone_cores_busy": (time.process_time() - cpu0) / soil_total,
+        "coupled_over_soil_alone": total / soil_total,
     })
     return out
 
@@ -218,8 +234,10 @@ def main(argv=None) -> int:
           f"({smoke['protocol_wall_seconds']:.0f} s for {smoke['protocol_simulated_seconds']:.2f} s); per DEM step "
           f"{smoke['ms_per_step']:.2f} ms = soil {smoke['ms_per_step_soil']:.2f} + wheel {smoke['ms_per_step_wheel']:.2f}"
           f" ({smoke['fe_substeps_per_dem_step']:.0f} sub-steps) + contact {smoke['ms_per_step_contact_evaluation']:.2f}"
-          f" + rebuild {smoke['ms_per_step_contact_rebuild']:.2f}; {smoke['cores_busy']:.2f} cores busy; "
-          f"peak RSS {smoke['peak_rss_mib']:.0f} MiB", flush=True)
+          f" + rebuild {smoke['ms_per_step_contact_rebuild']:.2f}; {smoke['cores_busy']:.2f} cores busy "
+          f"({smoke['protocol_cores_busy']:.2f} over the whole protocol); the soil alone {smoke['ms_per_step_soil_alone']:.2f}"
+          f" ms per step ({smoke['soil_alone_cores_busy']:.2f} cores): coupled / soil alone "
+          f"{smoke['coupled_over_soil_alone']:.2f} (goal <= 1.5); peak RSS {smoke['peak_rss_mib']:.0f} MiB", flush=True)
     print("seed-004 scale parts (own processes) ...", flush=True)
     fe = report["seed004_wheel"] = _child("fe-seed004", args.arch, args.steps)
     print(f"  wheel {fe['fe_elements']} elements, {fe['contact_facets']} contact facets: "
