@@ -181,3 +181,16 @@ def test_prepare_bed_takes_a_case_or_options_not_both(capsys):
     assert "--set needs a CASE" in capsys.readouterr().err
     assert main(["prepare-bed", "mini-1g-steer", "--set", "soil.lenght=2"]) == EXIT_INPUT
     assert "unknown key soil.lenght; did you mean soil.length?" in capsys.readouterr().err
+
+
+def test_the_readme_example_case_is_the_preset_it_says(tmp_path):
+    """README: 'this one is the smoke-moon-steer preset (the same case hash)' -- the example is a test."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    m = re.search(r"this one is the `([\w-]+)` preset.*?```toml\n(.*?)```", readme, re.S)
+    assert m, "the README's example case block was not found"
+    path = tmp_path / "example.toml"
+    path.write_text(m.group(2))
+    assert load_case(path, name=m.group(1)).case_hash() == load_case(m.group(1)).case_hash()
