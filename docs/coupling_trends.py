@@ -183,7 +183,8 @@ def write_report(res: dict, found: dict, path: Path) -> None:
         "2.0 × 0.9 × 0.2 m periodic bed (moving soil patch) of 25–37.5 mm particles (≈ 12,000), ω = 1 rad/s.",
         "Particles are about 1.5× seed 004's and the bed shallower; how far the forces move under refinement is",
         "measured in [testbed-numbers.md](testbed-numbers.md) (convergence study). Means ± standard errors from",
-        "the pitch means; the tread slip is the slip the tread saw (commanded: the run's name).",
+        "the pitch means; the tread slip is the slip the tread saw (commanded: the run's name). Wall: each",
+        "run's own wall time, measured while other runs shared the two cores (not a speed figure).",
         "",
         "Sinkage is the hub's drop below where the undeformed tread touches the surface, so it includes the",
         "wheel's deflection; tread sinkage is the depth of the lowest point of the tread below the surface.",
@@ -240,8 +241,13 @@ def reading(res: dict, found: dict) -> list[str]:
     out = ["## Reading", ""]
     unsteady = [n for n, r in res.items() if not r["steady"]]
     if unsteady:
-        out += [f"* Runs without a detected steady state ({', '.join(unsteady)}) are shown over their last window "
-                "but are not read as evidence below; their reasons are listed under the table.", ""]
+        out += [f"* Runs without a detected steady state ({', '.join(unsteady)}) are shown over their last window; "
+                "a reading below that rests on one says so and is indicative only (reasons under the table).", ""]
+
+    def caveat(names) -> str:
+        bad = [n for n in names if n in res and not res[n]["steady"]]
+        return f" *Indicative only: {', '.join(bad)} not steady.*" if bad else ""
+
     off = [n for n, r in res.items() if abs(r["tread_slip"][0] - r["meta"]["testbed"]["slip"]) > 0.03]
     if off:
         out += [f"* The tread slip of {', '.join(off)} differs from the commanded slip by more than 0.03.", ""]
@@ -249,13 +255,15 @@ def reading(res: dict, found: dict) -> list[str]:
         dp = list(found["dp_vs_slip"].values())
         ts = [1e3 * res[n]["tread_sinkage"][0] for n in ("1g-W3000-i0.1-b0", "1g-W3000-i0.3-b0", "1g-W3000-i0.5-b0")]
         out += [f"* **Slip.** Drawbar pull rises monotonically ({dp[0]:.0f} → {dp[-1]:.0f} N from i = 0.1 to 0.5) and "
-                f"the tread sinks deeper ({ts[0]:.1f} → {ts[-1]:.1f} mm), as in seed 004 (Figs. 6–7).", ""]
+                f"the tread sinks deeper ({ts[0]:.1f} → {ts[-1]:.1f} mm), as in seed 004 (Figs. 6–7)."
+                + caveat(("1g-W3000-i0.1-b0", "1g-W3000-i0.3-b0", "1g-W3000-i0.5-b0")), ""]
     if "dp_vs_beta" in found:
         dp = list(found["dp_vs_beta"].values())
         fy = list(found["minus_fy_vs_beta"].values())
         out += [f"* **Steering.** From β = 0 to 20° drawbar pull falls by {100 * (1 - dp[-1] / dp[0]):.0f} % and the "
                 f"lateral force grows from {fy[0]:.0f} to {fy[-1]:.0f} N (seed 004 at 1g, 3000 N: drawbar pull "
-                "−36.9 % on average from 5 to 20°, lateral force +301 %).", ""]
+                "−36.9 % on average from 5 to 20°, lateral force +301 %)."
+                + caveat(("1g-W3000-i0.3-b0", "1g-W3000-i0.3-b10", "1g-W3000-i0.3-b20")), ""]
     if "gravity_difference_percent" in found:
         d = found["gravity_difference_percent"]
         g1, gm = res["1g-W3000-i0.3-b10"], res["moon-W500-i0.3-b10"]
@@ -265,7 +273,7 @@ def reading(res: dict, found: dict) -> list[str]:
                 f"sinkage changes by {d['tread_sinkage']:+.0f} %, close to seed 004's 12 % (its largest differences "
                 f"reach 25 %). The hub's drop ({d['sinkage']:+.0f} %) is dominated by the wheel's own deflection, "
                 f"{defl[0]:.0f} mm under 3000 N against {defl[1]:.0f} mm under 500 N. Seed 004 does not say which it "
-                "measures.", ""]
+                "measures." + caveat(("1g-W3000-i0.3-b10", "moon-W500-i0.3-b10")), ""]
     if "flexible_over_rigid_dp" in found:
         ratio, err = found["flexible_over_rigid_dp"]
         f, r = res["1g-W3000-i0.3-b0"], res["1g-W3000-i0.3-b0-rigid"]
@@ -275,7 +283,8 @@ def reading(res: dict, found: dict) -> list[str]:
                 f"against the rigid wheel's {1e3 * r['tread_sinkage'][0]:.0f} mm. Seed 001's factor is for loosely "
                 "packed soil modelled as a continuum (Drucker–Prager cap), where the rigid wheel's extra sinkage costs "
                 f"compaction resistance. Here the bed is dense (packing fraction {f['packing_fraction']:.2f}) and "
-                "coarse: a 25–37.5 mm particle is as large as the grousers.", ""]
+                "coarse: a 25–37.5 mm particle is as large as the grousers."
+                + caveat(("1g-W3000-i0.3-b0", "1g-W3000-i0.3-b0-rigid")), ""]
     return out
 
 
