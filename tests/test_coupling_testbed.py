@@ -83,6 +83,7 @@ def test_render_of_the_last_state_shows_wheel_and_soil(steering_run, tmp_path):
     assert coloured.mean() > 0.05
 
 
+@pytest.mark.slow  # a 28 s run; the fast tier keeps the flexible wheel's tread-slip checks
 def test_rigid_wheel_tread_turns_with_the_hub(mini_bed):
     """A rigid wheel cannot wind up: its tread slip and slip angle are the commanded ones, to round-off."""
     bench = Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, rigid=True, drive_time=0.15, average_time=0.05))
