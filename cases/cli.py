@@ -19,7 +19,6 @@ from wheelsoil.gravity import GRAVITY_PRESETS
 
 EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
-
 MAIN_HELP = """\
 wheelsoil: a single-wheel terramechanics testbed in software.
 

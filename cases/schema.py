@@ -43,7 +43,6 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 
-
 class CaseError(WheelsoilInputError):
     """A case file (or override) that does not validate; ``problems`` lists one line per error."""
 
