@@ -121,9 +121,9 @@ class WheelGeometry:
 
 
 #: Peak resident memory per wheel element while a wheel is meshed, assembled and stepped [bytes]: an upper
-#: bound, about 2.5 x the 6.6 KiB per element measured for the 25,920-element seed-004 wheel (281 MiB less the
-#: 110 MiB interpreter; benchmarks/README.md, testbed throughput).
-BYTES_PER_ELEMENT = 16384
+#: bound, about 2.3 x the 27.8 KiB per element measured for the 25,920-element seed-004 wheel (822 MiB less the
+#: 119 MiB interpreter, 2026-11-24; benchmarks/README.md, testbed throughput).
+BYTES_PER_ELEMENT = 65536
 
 
 def estimated_elements(g: WheelGeometry) -> int:

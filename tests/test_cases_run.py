@@ -56,6 +56,12 @@ def test_result_file_follows_the_architecture_layout(reference):
             n = f["frames"][k]["particles/position"].shape[0]
             assert f["frames"][k]["particles/velocity"].shape == (n, 3) == (f["frames"][k]["particles/radius"].shape[0], 3)
         assert f["frames"][frames[-1]]["wheel/nodes"].shape == f["mesh/nodes0"].shape
+    # what the readers of results (validation's periodic report, the throughput benchmark) take from the run info
+    from wheelsoil.cases.results import load_result
+    from wheelsoil.validation.periodic import drive_start
+
+    info = load_result(out / RESULT_NAME).info
+    assert 0 < drive_start(info) < info["simulated_seconds"] and "t_hold" in info and "t_wind_up" in info
     # a frame at the first sample past each multiple of 0.05 s, and the last state
     dt = case.output.sample_interval
     expected = [k * 0.05 for k in range(1, int(t[-1] / 0.05) + 1)]

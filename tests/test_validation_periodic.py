@@ -109,9 +109,9 @@ def test_bad_series_are_refused():
 class _FakeResult:
     """The parts of a result file runs_from_results reads: the case, run info and series."""
 
-    def __init__(self, case, t, y, t_drive_start):
+    def __init__(self, case, t, y, t_spin_up):
         self.case, self.path = case, f"{case.name}.h5"
-        self.info = {"t_drive_start": t_drive_start}
+        self.info = {"t_spin_up": t_spin_up}
         self.series = {"t": t, "torque": y}
 
 

@@ -250,7 +250,7 @@ def runs_from_results(results, quantity: str = "torque", *, noise: str = "red", 
         if quantity not in r.series:
             raise WheelsoilInputError(f"{r.path} has no series {quantity!r}; it has {sorted(r.series)}")
         case = r.case
-        t0 = float(r.info["t_drive_start"]) + case.test.spin_up_time
+        t0 = float(drive_start(r.info)) + case.test.spin_up_time
         sel = r.series["t"] >= t0 - 1e-12
         t, y = r.series["t"][sel], r.series[quantity][sel]
         comp = dominant_component(t, y, min_cycles=min_cycles, noise=noise)
@@ -269,6 +269,15 @@ def rig_configuration(case) -> str:
     g = -case.soil.gravity_vector[2]
     gname = gravity_label(g, moon="moon", other="g={g:.3g}")
     return f"{'rigid' if case.wheel.rigid else 'flexible'} wheel, {gname}, W = {case.test.load:g} N"
+
+
+def drive_start(info: dict) -> float:
+    """Simulated time [s] at which a run's spin-up began, from its run info (``t_spin_up``; result files
+    written before the wind-up protocol call it ``t_drive_start``)."""
+    for key in ("t_spin_up", "t_drive_start"):
+        if key in info:
+            return float(info[key])
+    raise WheelsoilInputError(f"the run info has no spin-up time (t_spin_up); keys: {sorted(info)}")
 
 
 def periodic_report(results, quantity: str = "torque", *, source: str = "the runs", report=None,
