@@ -116,7 +116,6 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
 
 def write_comparison_report(c: Comparison, data: Measurements, simulated: Measurements, out, *, command: str = "") -> dict:
     """report.md, findings.json and measured_vs_simulated.png in ``out``; returns the findings."""
-    import json
     from pathlib import Path
 
     import matplotlib
@@ -124,7 +123,7 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from wheelsoil.provenance import atomic_output, provenance
+    from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -169,9 +168,6 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
     else:
         lines += ["", f"No residual trend reaches p < {TREND_P:g}."]
     lines += ["", "![measured vs simulated](measured_vs_simulated.png)"]
-    with atomic_output(out / "report.md") as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
-    with atomic_output(out / "findings.json") as tmp:
-        tmp.write_text(json.dumps(findings, indent=1))
-    findings["report"] = str(out / "report.md")
+    findings["report"] = str(write_markdown_and_json(out / "report.md", "\n".join(lines) + "\n",
+                                                     out / "findings.json", findings))
     return findings

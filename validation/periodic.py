@@ -22,7 +22,6 @@ about each law, with BIC charging the fitted laws for their parameters: each mus
 by :data:`BIC_MARGIN`.
 """
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,7 +31,7 @@ from scipy.signal import periodogram
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import gravity_label
-from wheelsoil.provenance import atomic_output
+from wheelsoil.provenance import write_markdown_and_json
 
 #: p-value below which a periodogram peak counts as a periodic component.
 SIGNIFICANCE = 1e-3
@@ -313,9 +312,6 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
            "configurations": groups}
     if report is not None:
         report = Path(report)
-        report.mkdir(parents=True, exist_ok=True)
-        with atomic_output(report / "periodic.json") as tmp:
-            tmp.write_text(json.dumps(out, indent=1))
         lines = [f"# Periodic components of {quantity} in {source}", ""]
         if command:
             lines += [f"Reproduce: `{command}`", ""]
@@ -343,7 +339,6 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
                 short = "; at least 3 are needed" if found["significant_runs"] < 3 else ""
                 lines += ["", f"No law explains them within {LAW_TOLERANCE:.0%} and beats the simpler laws by "
                           f"{BIC_MARGIN:g} in BIC ({found['significant_runs']} significant runs{short})."]
-        with atomic_output(report / "periodic.md") as tmp:
-            tmp.write_text("\n".join(lines) + "\n")
-        out["report"] = str(report / "periodic.md")
+        out["report"] = str(write_markdown_and_json(report / "periodic.md", "\n".join(lines) + "\n",
+                                                    report / "periodic.json", out))
     return out

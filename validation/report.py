@@ -1,11 +1,10 @@
 """The validation report: markdown with plots, and a JSON of the findings, for one discovery run."""
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from wheelsoil.provenance import atomic_output, provenance
+from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
 from .discovery import Discovery, model_responses
 from .measured import Measurements
@@ -151,8 +150,5 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
                   "beyond two bootstrap standard deviations."]
     lines += ["", "![](fits.png)", ""]
     md, js = out / "report.md", out / "findings.json"
-    with atomic_output(js) as tmp:
-        tmp.write_text(json.dumps(findings, indent=1, default=float))
-    with atomic_output(md) as tmp:
-        tmp.write_text("\n".join(lines))
+    write_markdown_and_json(md, "\n".join(lines), js, findings, default=float)
     return md, js, findings

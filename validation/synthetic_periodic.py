@@ -2,14 +2,13 @@
 drawbar-pull series with a hidden periodic mechanism (:mod:`.synthetic`), with a report that reveals the truth
 at its end. A workflow above both modules, so that neither imports the other's caller."""
 
-import json
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.provenance import atomic_output
+from wheelsoil.provenance import atomic_output, write_markdown_and_json
 
 from . import synthetic as syn
 from .oscillation import oscillation_findings
@@ -78,11 +77,8 @@ def synthetic_periodic_report(hidden: str | None = None, *, seed: int = 0, repor
         _amplitude_plot(amp, report / "amplitudes.png")
         lines += ["", "![amplitudes](amplitudes.png)"]
     lines += ["", "## The hidden truth", "", f"Hidden: {hidden or 'nothing'} {params or ''}"]
-    with atomic_output(report / "report.md") as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
-    with atomic_output(report / "findings.json") as tmp:
-        tmp.write_text(json.dumps(out, indent=1))
-    out["report"] = str(report / "report.md")
+    out["report"] = str(write_markdown_and_json(report / "report.md", "\n".join(lines) + "\n",
+                                                report / "findings.json", out))
     return out
 
 

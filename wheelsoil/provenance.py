@@ -4,6 +4,7 @@
   or killed run never leaves a file that looks finished.
 * :func:`writable_folder`, :func:`writable_file` -- check (and make) an output place before any work, so a
   bad ``--out`` is an input error naming it and not a traceback after minutes of simulation.
+* :func:`write_markdown_and_json` -- a report's markdown and JSON files, each atomically.
 * :func:`provenance` -- the versions and revision every result file carries.
 """
 
@@ -66,6 +67,19 @@ def writable_file(path: str | os.PathLike, what: str = "--out") -> Path:
         raise WheelsoilInputError(f"{what} {str(target)!r} is a folder; give a file name")
     writable_folder(target.parent, f"{what} {str(target)!r}: its folder")
     return target
+
+
+def write_markdown_and_json(markdown_path: str | os.PathLike, markdown: str, json_path: str | os.PathLike,
+                            data, *, default=None) -> Path:
+    """A report's two files, each written atomically: the markdown text and ``data`` as indented JSON
+    (``default`` converts what JSON cannot hold, as in :func:`json.dumps`); returns the markdown path."""
+    import json
+
+    with atomic_output(json_path) as tmp:
+        tmp.write_text(json.dumps(data, indent=1, default=default))
+    with atomic_output(markdown_path) as tmp:
+        tmp.write_text(markdown)
+    return Path(markdown_path)
 
 
 def git_revision() -> str | None:
