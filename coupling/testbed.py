@@ -59,10 +59,10 @@ from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, check_
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed, BedSpec, check_memory, machine_memory
-from wheelsoil.granular.materials import SOIL_STEEL, PairProperties
+from wheelsoil.granular.materials import SOIL_STEEL, PairProperties, effective_modulus
 from wheelsoil.granular.timestep import estimate_time_step
 
-from .contact import WheelContact
+from .contact import WheelContact, contact_material
 from .kinematics import TreadTracker, deformation, slip_angle_deg
 from .patch import MovingPatch, PatchGeometry
 from .steady import SteadyState, detect_steady_state, window_stats
@@ -269,6 +269,14 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
         if spec.time_step > est.stable:
             raise WheelsoilInputError(f"soil.time_step = {spec.time_step:.3g} s exceeds the stable time step of "
                                       f"the particle pairs: {est.describe()}")
+    # a lower bound of the run's DEM step: the smallest possible radius, and the walls' and the wheel's contacts
+    # beside the pairs (the scene's estimate uses the spheres' actual smallest radius, never below it)
+    moduli = (effective_modulus(bed.material, bed.wall_material),
+              effective_modulus(bed.material, contact_material(wheel.material)))
+    shortest = spec.time_step or estimate_time_step(0.5 * bed.diameter_min, bed.material, wall_moduli=moduli).stable
+    if spec.sample_interval < shortest:
+        raise WheelsoilInputError(f"output.sample_interval = {spec.sample_interval:.3g} s is shorter than the "
+                                  f"run's DEM step (at least {shortest:.3g} s): a sample averages at least one step")
     pressure = spec.load / (wheel.width * wheel.radius)
     if pressure > 0.05 * bed.material.youngs_modulus:
         # a nominal pressure p over a contact of about one radius: Hertz overlaps grow as (p / E)^(2/3) of the

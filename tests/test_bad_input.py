@@ -44,6 +44,7 @@ def test_an_output_folder_that_cannot_be_written(where, a_file, tmp_path, capsys
     ("wheel.element_size=1e-5", ["wheel.element_size = 1e-05 m", "GiB"]),
     ("soil.diameter_min=0.001", ["soil.diameter_min", "GiB"]),
     ("soil.time_step=1e-2", ["soil.time_step = 0.01 s exceeds the stable time step"]),
+    ("output.sample_interval=1e-12", ["output.sample_interval = 1e-12 s is shorter than the run's DEM step"]),
 ])
 def test_values_a_run_cannot_survive_are_refused_by_case_check(override, needles, capsys):
     big = override.startswith("soil.diameter_min")  # 1-1.5 mm in the smoke bin: ~2e8 spheres, ~900 GiB
