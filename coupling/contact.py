@@ -235,10 +235,10 @@ class WheelContact(Interaction):
         if self._need_rebuild or scene.neighbor_rebuilds != self._seen_rebuilds:
             self._rebuild(scene)
         self._launch_contacts(dt)
-        stats = self._stats.to_numpy()
-        self._n_contacts = int(stats[1])
+        # two scalar reads (~25 us) rather than to_numpy (~100 us: a copy kernel and an array)
+        self._n_contacts = int(self._stats[1])
         # rebuild before the wheel's surface has moved its skin (less a margin for one more step)
-        if stats[0] > (0.8 * self.wheel_skin) ** 2:
+        if self._stats[0] > (0.8 * self.wheel_skin) ** 2:
             self._need_rebuild = True
         return self._n_contacts
 

@@ -1,7 +1,9 @@
 """Taichi runtime set-up shared by every solver in the package.
 
 Taichi is initialised once per process. The offline kernel cache is on (kernels compiled once are
-reused by later processes), and its location can be moved with ``WHEELSOIL_TAICHI_CACHE``.
+reused by later processes), and its location can be moved with ``WHEELSOIL_TAICHI_CACHE``. On the CPU
+backend the worker threads are pinned one to a core (:mod:`wheelsoil.threads`; ``WHEELSOIL_PIN_THREADS=0``
+switches it off).
 """
 
 from __future__ import annotations
@@ -79,6 +81,10 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
             f"arch={requested!r}: no {requested} device is usable on this machine (Taichi would fall back to "
             f"the CPU, {actual.name}); use --arch cpu, or run where the device and its driver are installed"
         )
+    if requested == "cpu":
+        from . import threads
+
+        threads.pin_worker_threads(int(ti.lang.impl.current_cfg().cpu_max_num_threads))
     _state["init_seconds"] = time.perf_counter() - t0
     _state["arch"] = requested
     return requested
