@@ -14,6 +14,7 @@ from pathlib import Path
 
 import taichi as ti
 
+from . import threads
 from .errors import WheelsoilInputError
 
 _ARCHES = {
@@ -81,11 +82,9 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
             f"arch={requested!r}: no {requested} device is usable on this machine (Taichi would fall back to "
             f"the CPU, {actual.name}); use --arch cpu, or run where the device and its driver are installed"
         )
-    if requested == "cpu":
-        from . import threads
-
-        threads.pin_worker_threads(int(ti.lang.impl.current_cfg().cpu_max_num_threads))
     _state["init_seconds"] = time.perf_counter() - t0
+    if requested == "cpu":
+        threads.pin_worker_threads(int(ti.lang.impl.current_cfg().cpu_max_num_threads))
     _state["arch"] = requested
     return requested
 
