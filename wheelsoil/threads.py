@@ -2,10 +2,10 @@
 
 Taichi's CPU backend splits a parallel loop into one task per worker thread (about half the items each on two
 cores, as measured with Taichi 1.7.4) and each worker sleeps on a condition variable between loops. Left to
-the Linux scheduler on the 2-core benchmark VM, a woken worker was often placed on the core its partner was
-already running on: in 11,927-item loops of ~2 ms, the second worker took no part at all in about a third of
-the launches, and where it did, often only after its partner had done much of the work (the order in which
-items were processed shows it; ``benchmarks/README.md``). Pinned one to a core, the second worker joined
+the Linux scheduler on the 2-core benchmark VM, the second worker often did not start within a loop, or ran on
+its partner's core, the two taking turns: in 11,927-item loops of ~2 ms it took no part at all in about a third
+of the launches, and in others joined only after its partner had done much of the work (the order in which
+the items were processed shows it; ``benchmarks/README.md``). Pinned one to a core, the second worker joined
 every launch within a few tens of microseconds and the loop took 2.09 ms instead of 3.55 ms (median of 30).
 
 :func:`pin_worker_threads` finds the workers by what they do (the threads that gain CPU time while a
@@ -15,7 +15,6 @@ on the CPU backend when the worker pool covers exactly the CPUs the process may 
 ``WHEELSOIL_PIN_THREADS=0`` to leave the threads to the scheduler (for example when other programs share the
 cores and should be able to push the solver's threads aside).
 """
-
 
 import os
 import sys
