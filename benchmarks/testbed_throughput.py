@@ -16,11 +16,15 @@ and a measured extrapolation to seed-004 scale (388,026 particles, the full-reso
    measured at smoke scale, then 0.1 s settle, 0.05 s spin-up, 2.5 s drive).
 
 Run:  python -m wheelsoil.benchmarks.testbed_throughput [--out benchmarks/results/testbed.json] [--arch cuda]
+      python -m wheelsoil.benchmarks.testbed_throughput --compare-pinning 3 --drive-time 0.05
+        (only the A/B of pinned and unpinned worker threads, :mod:`wheelsoil.threads`, in alternating processes)
 """
 
 import argparse
 import json
 import math
+import os
+import statistics
 import subprocess
 import sys
 import time
@@ -163,11 +167,14 @@ def base_part(arch) -> dict:
     return {"peak_rss_mib": own_peak_rss_mib()}
 
 
-def _child(part: str, arch, steps: int) -> dict:
+def _child(part: str, arch, steps: int, *, drive_time: float | None = None, env: dict | None = None) -> dict:
     cmd = [sys.executable, "-m", "wheelsoil.benchmarks.testbed_throughput", "--part", part, "--steps", str(steps)]
     if arch:
         cmd += ["--arch", arch]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if drive_time is not None:
+        cmd += ["--drive-time", repr(drive_time)]
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False,
+                          env=None if env is None else {**os.environ, **env})
     if done.returncode != 0:
         raise RuntimeError(f"benchmark part {part!r} failed:\n{done.stderr[-3000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
@@ -213,19 +220,52 @@ def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
     }
 
 
+def compare_pinning(args) -> int:
+    """Alternating processes with the worker threads pinned (``WHEELSOIL_PIN_THREADS=1``) and not (``0``): the
+    coupled step, its cores busy and the soil alone, per pair and as medians of the paired ratios."""
+    rows = []
+    keys = ("ms_per_step", "cores_busy", "ms_per_step_soil_alone", "soil_alone_cores_busy")
+    for k in range(args.compare_pinning):
+        row = {}
+        for label, value in (("pinned", "1"), ("unpinned", "0")):
+            out = _child("smoke", args.arch, args.steps, drive_time=args.drive_time, env={"WHEELSOIL_PIN_THREADS": value})
+            row[label] = {key: out[key] for key in keys}
+        rows.append(row)
+        p, u = row["pinned"], row["unpinned"]
+        print(f"pair {k + 1}: coupled {p['ms_per_step']:.2f} ms ({p['cores_busy']:.2f} cores) pinned, "
+              f"{u['ms_per_step']:.2f} ms ({u['cores_busy']:.2f} cores) unpinned; soil alone "
+              f"{p['ms_per_step_soil_alone']:.2f} / {u['ms_per_step_soil_alone']:.2f} ms", flush=True)
+    ratio = statistics.median(r["pinned"]["ms_per_step"] / r["unpinned"]["ms_per_step"] for r in rows)
+    soil = statistics.median(r["pinned"]["ms_per_step_soil_alone"] / r["unpinned"]["ms_per_step_soil_alone"] for r in rows)
+    print(f"median pinned / unpinned time: coupled step {ratio:.3f}, soil alone {soil:.3f} ({len(rows)} pairs)")
+    report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv), "pairs": rows,
+              "median_pinned_over_unpinned": {"coupled_step": ratio, "soil_alone": soil}}
+    out = args.out.with_name(args.out.stem + "-pinning.json")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(report, indent=2, default=float))
+    print(f"wrote {out}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results/testbed.json"))
     ap.add_argument("--steps", type=int, default=600, help="DEM steps timed in steady driving (default 600)")
     ap.add_argument("--drive-time", type=float, default=0.3, help="smoke protocol drive time [s] (default 0.3)")
     ap.add_argument("--arch", default=None, help="Taichi backend (default cpu)")
-    ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base"), help=argparse.SUPPRESS)
+    ap.add_argument("--compare-pinning", type=int, default=0, metavar="PAIRS",
+                    help="only compare worker threads pinned and not (WHEELSOIL_PIN_THREADS): PAIRS alternating "
+                         "pairs of processes, each timing --steps coupled steps and the soil alone at smoke scale")
+    ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.part:
         fn = {"fe-seed004": lambda: fe_seed004_part(min(args.steps, 200), args.arch),
-              "dem-seed004": lambda: dem_seed004_part(args.arch), "base": lambda: base_part(args.arch)}[args.part]
-        print(json.dumps(fn()))
+              "dem-seed004": lambda: dem_seed004_part(args.arch), "base": lambda: base_part(args.arch),
+              "smoke": lambda: smoke_part(args.steps, args.drive_time, args.arch)}[args.part]
+        print(json.dumps(fn(), default=float))
         return 0
+    if args.compare_pinning:
+        return compare_pinning(args)
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
     print("smoke scale: whole protocol, then timed steady driving ...", flush=True)
