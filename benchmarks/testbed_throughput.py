@@ -57,7 +57,7 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
     from wheelsoil.granular import prepare_bed
 
     case = load_case("smoke-1g-steer", [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
-                                        "output.average_time=0.1"])
+                                        f"output.average_time={min(0.1, 0.5 * drive_time)!r}"])
     bed = prepare_bed(case.bed_spec(), arch=arch)
     t0 = time.perf_counter()
     bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
