@@ -99,7 +99,10 @@ def pin_worker_threads(n_workers: int) -> dict[int, int]:
     cpus = sorted(os.sched_getaffinity(0))
     if n_workers < 2 or n_workers != len(cpus):
         return {}
-    workers = find_worker_threads(n_workers)
+    try:
+        workers = find_worker_threads(n_workers)
+    except Exception:  # noqa: BLE001 - an optimisation that cannot run must never stop a simulation
+        return {}
     if len(workers) != n_workers:
         return {}
     pinned = {}
