@@ -61,3 +61,27 @@ def test_environment_switch_values(monkeypatch):
     for value, expected in (("", True), ("1", True), ("on", True), ("0", False), ("False", False), ("no", False)):
         monkeypatch.setenv(threads.ENV_VAR, value)
         assert threads.requested_by_environment() is expected
+
+
+def _fresh(monkeypatch, cpus=(0, 1)):
+    monkeypatch.setattr(threads, "_state", {"pinned": {}})
+    monkeypatch.setattr(threads, "supported", lambda: True)
+    monkeypatch.delenv(threads.ENV_VAR, raising=False)
+    monkeypatch.setattr(threads.os, "sched_getaffinity", lambda pid: set(cpus))
+
+
+def test_a_failing_calibration_pins_nothing(monkeypatch):
+    _fresh(monkeypatch)
+
+    def broken(n_workers):
+        raise RuntimeError("no calibration on this machine")
+
+    monkeypatch.setattr(threads, "find_worker_threads", broken)
+    assert threads.pin_worker_threads(2) == {}
+
+
+def test_a_pool_that_does_not_cover_the_cpus_is_left_alone(monkeypatch):
+    _fresh(monkeypatch, cpus=(0, 1, 2, 3))
+    called = []
+    monkeypatch.setattr(threads, "find_worker_threads", lambda n: called.append(n) or [])
+    assert threads.pin_worker_threads(2) == {} and called == []  # decided before any calibration
