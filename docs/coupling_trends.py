@@ -23,6 +23,7 @@ Runs go to ``wheelsoil-output/trends/<run>/`` (series.csv, summary.json, series.
 """
 
 import argparse
+import csv
 import json
 import math
 import re
@@ -189,8 +190,6 @@ SERIES_COLUMNS = {"drawbar_pull": "drawbar_pull[N]", "lateral_force": "lateral_f
 
 def second_means(path: Path, quantity: str, start: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
     """Means of ``quantity`` over consecutive whole seconds of the run from ``start`` [s] (series.csv)."""
-    import csv
-
     with open(path / "series.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     t = np.array([float(r["t[s]"]) for r in rows])

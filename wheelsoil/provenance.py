@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import json
 import os
 import subprocess
 import tempfile
@@ -73,8 +74,6 @@ def write_markdown_and_json(markdown_path: str | os.PathLike, markdown: str, jso
                             data, *, default=None) -> Path:
     """A report's two files, each written atomically: the markdown text and ``data`` as indented JSON
     (``default`` converts what JSON cannot hold, as in :func:`json.dumps`); returns the markdown path."""
-    import json
-
     with atomic_output(json_path) as tmp:
         tmp.write_text(json.dumps(data, indent=1, default=default))
     with atomic_output(markdown_path) as tmp:

@@ -18,6 +18,7 @@ cores and should be able to push the solver's threads aside).
 
 import os
 import sys
+import threading
 
 import taichi as ti
 
@@ -65,7 +66,7 @@ def find_worker_threads(n_workers: int, *, launches: int = 40, min_ns: int = 200
     values = ti.ndarray(ti.f64, shape=20_000)
     values.fill(0.5)
     _calibration(values, 2)  # compile outside the measurement
-    me = {os.getpid(), _thread_self()}
+    me = {os.getpid(), threading.get_native_id()}
     before = {t: _cpu_ns(t) for t in _thread_ids()}
     found: list[int] = []
     for k in range(launches):
@@ -76,15 +77,6 @@ def find_worker_threads(n_workers: int, *, launches: int = 40, min_ns: int = 200
             if len(found) >= n_workers:
                 break
     return sorted(found[:n_workers])
-
-
-def _thread_self() -> int:
-    try:
-        import threading
-
-        return threading.get_native_id()
-    except AttributeError:  # pragma: no cover - Python < 3.8
-        return os.getpid()
 
 
 def pin_worker_threads(n_workers: int) -> dict[int, int]:
