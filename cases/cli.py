@@ -390,7 +390,9 @@ def summary_lines(s: dict) -> list[str]:
     for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
         st = s[q]
         sem = st.get("sem", float("nan"))
-        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}, fluctuation {st['std']:.3g})")
+        zero = ": zero within its noise, no trend" if st.get("zero_within_noise") else ""
+        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}, fluctuation "
+                     f"{st['std']:.3g}{zero})")
     if "tread_slip" in s:
         lines.append(f"  {'tread slip':16s} {s['tread_slip']['mean']:10.4f}      (commanded {s.get('commanded_slip', float('nan')):g}; "
                      f"tread slip angle {s['tread_slip_angle']['mean']:.2f} deg, commanded "

@@ -677,7 +677,10 @@ class Testbed:
                 st = window_stats(np.asarray(rows[q], float), state.bounds)  # batch means over the same pitches
             st = st or {}
             summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
-                          "drift": float(st.get("drift", math.nan)), "units": SERIES_UNITS[q]}
+                          "drift": float(st.get("drift", math.nan)), "drift_sem": float(st.get("drift_sem", math.nan)),
+                          "units": SERIES_UNITS[q]}
+            if "zero_within_noise" in st:
+                summary[q]["zero_within_noise"] = bool(st["zero_within_noise"])
         ts = state.stats.get("tread_slip")
         if ts is not None:
             summary["tread_slip"] = {**{k: float(v) for k, v in ts.items()}, "units": "1"}
