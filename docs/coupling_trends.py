@@ -89,6 +89,7 @@ def load_run(path: Path) -> dict:
            "tread_slip": (float(s["tread_slip"]["mean"]), float(s["tread_slip"].get("sem", math.nan)))}
     for q in QUANTITIES:
         out[q] = (float(s[q]["mean"]), float(s[q]["std"]), float(s[q]["sem"]))
+    out["zero_within_noise"] = [q for q in QUANTITIES if s[q].get("zero_within_noise")]
     m = re.search(r"packing fraction ([0-9.]+)", meta.get("bed", ""))
     out["packing_fraction"] = float(m.group(1)) if m else math.nan
     return out
@@ -224,10 +225,8 @@ def wander(res: dict) -> list[str]:
     return ["What the runs that are not steady do over their whole drive (1-s means; a trend would show as a rank",
             "correlation near ±1 with a small p):", ""] + out + [
         "",
-        "Where the correlation is weak these quantities wander over about a second rather than drift: slower than",
-        "a pitch (30° of tread, 0.5 s) and larger than the detector's allowance, which for a force near zero is its",
-        "absolute floor (±15 N for the lateral force of a straight run). More driving does not remove such a",
-        "wander; a criterion that accounts for the signal's correlation time would. That is left open (issue 17).",
+        "Where the correlation is weak these quantities wander rather than drift, by more than the detector's",
+        "allowance (10 % of the mean) within a window; more driving does not remove such a wander.",
         ""]
 
 
@@ -254,11 +253,14 @@ def write_report(res: dict, found: dict, path: Path) -> None:
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, r in res.items():
-        cells = [f"{r[q][0]:.0f} ± {r[q][2]:.0f}" for q in QUANTITIES[:4]]
+        cells = [f"{r[q][0]:.0f} ± {r[q][2]:.0f}{' (0)' if q in r['zero_within_noise'] else ''}"
+                 for q in QUANTITIES[:4]]
         cells += [f"{1e3 * r[q][0]:.1f} ± {1e3 * r[q][2]:.1f}" for q in ("sinkage", "tread_sinkage")]
         lines.append(f"| {name} | {'yes' if r['steady'] else '**no**'} | {r['window'][0]:.2f}–{r['window'][1]:.2f} | "
                      f"{r['tread_slip'][0]:.3f} | " + " | ".join(cells) + f" | {r['meta']['run']['wall_seconds']:.0f} |")
-    lines.append("")
+    lines += ["", "(0): zero within its noise (|mean| < 2 standard errors): judged steady by not trending beyond 2 "
+              "standard errors instead of by the tolerance (`coupling/steady.py`; how often that is wrong: "
+              "[steady-detector.md](steady-detector.md)).", ""]
     for name, r in res.items():
         if not r["steady"]:
             lines.append(f"* {name} is **not steady**: {'; '.join(r['reasons'])}.")
@@ -321,8 +323,11 @@ def reading(res: dict, found: dict) -> list[str]:
     if "dp_vs_beta" in found:
         dp = list(found["dp_vs_beta"].values())
         fy = list(found["minus_fy_vs_beta"].values())
+        straight = res["1g-W3000-i0.3-b0"]
+        fy0 = (f"zero within its noise ({straight['lateral_force'][0]:+.0f} ± {straight['lateral_force'][2]:.0f} N)"
+               if "lateral_force" in straight["zero_within_noise"] else f"{fy[0]:.0f}")
         out += [f"* **Steering.** From β = 0 to 20° drawbar pull falls by {100 * (1 - dp[-1] / dp[0]):.0f} % and the "
-                f"lateral force grows from {fy[0]:.0f} to {fy[-1]:.0f} N (seed 004 at 1g, 3000 N: drawbar pull "
+                f"lateral force grows from {fy0} to {fy[-1]:.0f} N (seed 004 at 1g, 3000 N: drawbar pull "
                 "−36.9 % on average from 5 to 20°, lateral force +301 %)."
                 + caveat(("1g-W3000-i0.3-b0", "1g-W3000-i0.3-b10", "1g-W3000-i0.3-b20")), ""]
     if "gravity_difference_percent" in found:

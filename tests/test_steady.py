@@ -142,3 +142,58 @@ def test_a_drift_within_its_noise_beyond_the_tolerance_is_refused_and_says_so(se
         assert ("within its own noise" in reasons[0]) == (abs(st["drift"]) < 2 * st["drift_sem"])
     else:
         assert reasons == []
+
+
+def test_pitch_noise_recovers_the_scatter_of_pitch_means_and_sees_a_trend_only_through_its_step():
+    """Mean square successive difference (von Neumann 1941): over 400 draws of 12 independent pitch means with
+    sigma = 5, the mean of sigma_hat^2 is sigma^2 within 10 %; on a line rising by one sigma per pitch it is
+    sigma^2 + step^2 / 2, where the window's own standard deviation would be inflated by the whole rise."""
+    from wheelsoil.coupling.steady import pitch_noise
+
+    rng = np.random.default_rng(77)
+    sigma, m = 5.0, 12
+    flat = [pitch_noise(rng.normal(0.0, sigma, m)) ** 2 for _ in range(400)]
+    assert np.mean(flat) == pytest.approx(sigma**2, rel=0.1)
+    line = sigma * np.arange(m)
+    rising = [pitch_noise(line + rng.normal(0.0, sigma, m)) ** 2 for _ in range(400)]
+    assert np.mean(rising) == pytest.approx(sigma**2 + sigma**2 / 2, rel=0.1)
+    assert pitch_noise(np.array([1.0])) == math.inf
+
+
+def zero_quantity(seed, t, angle, sigma=40.0, rate=0.0):
+    """A force that is zero on average: independent pitch means scattered by sigma [N] (no floor or tolerance of
+    +-15 N can hold it), optionally trending at ``rate`` [N/s]. The pitches are counted back from the last sample,
+    as the detector counts them, so that its pitch means are independent (pitch means that straddle two
+    pitches are correlated, and the successive differences then see less than the whole scatter)."""
+    rng = np.random.default_rng(seed)
+    pitch_of = np.floor((angle[-1] - angle) / PITCH).astype(int)
+    return rng.normal(0.0, sigma, pitch_of.max() + 1)[pitch_of] + rate * t
+
+
+def test_a_quantity_zero_within_its_noise_is_steady_when_it_does_not_trend():
+    """The lateral force of a straight run: zero on average, pitch means scattered by 40 N, allowance +-15 N
+    (10 % of a 150 N floor). Over 100 draws the detector's default calls at least 75 % steady, flagged zero
+    within noise (expected about 85 %: each of |mean|, drift and halves exceeds 2 standard errors in about 5 %
+    of draws), nearly all of them flagged; with the tolerance alone (zero_within=0) at most 40 % (the drift over
+    ~10 pitches has a standard error of about 40 N against the 15 N allowed)."""
+    steady_default, steady_tolerance, flagged = 0, 0, 0
+    for seed in range(100):
+        t, series, angle, speed = synthetic_run(500 + seed)
+        series["lateral_force"] = zero_quantity(500 + seed, t, angle)
+        floors = {"drawbar_pull": 150.0, "lateral_force": 150.0}
+        state = detect(t, series, angle, speed, floors=floors)
+        steady_default += state.steady
+        flagged += state.steady and state.stats["lateral_force"]["zero_within_noise"]
+        steady_tolerance += detect(t, series, angle, speed, floors=floors, zero_within=0.0).steady
+    assert steady_default >= 75 and flagged >= 70  # a few pass the tolerance itself, by chance
+    assert steady_tolerance <= 40
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_zero_quantity_that_trends_is_not_steady_and_the_reason_names_it(seed):
+    """The same zero force trending at 150 N/s (about ten of its drift's standard errors over the window)."""
+    t, series, angle, speed = synthetic_run(seed)
+    series["lateral_force"] = zero_quantity(seed, t, angle, rate=150.0) - 150.0 * t[-1] / 2
+    state = detect(t, series, angle, speed, floors={"drawbar_pull": 150.0, "lateral_force": 150.0})
+    assert not state.steady
+    assert any(r.startswith("lateral_force") for r in state.reasons), state.reasons
