@@ -201,6 +201,8 @@ class Output(_Section):
                                            "floor: 5 % of W for forces)", gt=0, le=1)
     slip_tolerance: float = _q(0.03, "1", "largest difference between tread slip and commanded slip when steady",
                                gt=0, le=0.5)
+    steady_checks: int = Field(2, ge=1, le=10, description="consecutive checks, one period of the tread apart, "
+                               "that must find the run steady before it stops and is reported steady")
     frame_interval: float = _q(0.05, "s", "simulated time between frames (particles, wheel nodes) kept in the "
                                           "result; 0: the last frame only", ge=0)
     checkpoint_interval: float = _q(0.25, "s", "simulated time between checkpoints a killed run resumes from "
@@ -286,7 +288,7 @@ class CaseFile(BaseModel):
             drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
             windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
             sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
-            start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid, damping=self.wheel.damping,
+            steady_checks=o.steady_checks, start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid, damping=self.wheel.damping,
             axle_damping=t.axle_damping,
             pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
         )

@@ -50,7 +50,7 @@ synthetic runs with the smoke runs' noise (``docs/steady_campaign.py`` -> ``docs
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -240,6 +240,20 @@ def detect_steady_state(
     last = SteadyState(not reasons, k0, k1, (float(t[k0] - sample_interval), float(t[k1 - 1])), m, stats,
                        slip, slip_sem, reasons, [int(x) for x in b])
     return last
+
+
+def confirm_steady(state: SteadyState, in_a_row: int, required: int) -> tuple[SteadyState, int]:
+    """Count a check's verdict towards ``required`` steady verdicts in a row (checks one period apart).
+
+    Returns the verdict to report and the new count: a steady window that is not yet the ``required``-th in a
+    row is reported not steady, and says so. The detector is asked again every period while a run drives, so
+    one lucky window would let a drift comparable to its noise through sooner or later; requiring two in a row
+    cuts that several-fold for one period more (``docs/steady-detector.md``)."""
+    in_a_row = in_a_row + 1 if state.steady else 0
+    if state.steady and in_a_row < required:
+        state = replace(state, steady=False, reasons=[
+            f"steady at {in_a_row} check(s) in a row, one period apart; {required} are required (steady_checks)"])
+    return state, in_a_row
 
 
 def mser_truncation(batches: np.ndarray, latest: int) -> int:

@@ -30,9 +30,9 @@ Protocol:
    with the feedback it is c / ((K + 1) k_t)). It ends when the tread's spin over the last pitch is
    within ``slip_tolerance`` / 3 (in slip) of the commanded one; ``windup="none"``: no wind-up phase;
 5. *drive*: the hub spins at exactly omega -- the rig's command -- and the run goes on until a steady
-   window of at least ``average_time`` is found (:mod:`.steady`: whole pitches of the tread's rotation;
-   forces, torque, sinkage and tread slip without drift; tread slip within ``slip_tolerance`` of the
-   commanded slip), or until ``drive_time`` has passed since the spin-up ended (then the summary says the
+   window of at least ``average_time`` is found at ``steady_checks`` checks in a row, one pitch apart
+   (:mod:`.steady`: whole pitches of the tread's rotation; forces, torque, sinkage and tread slip without
+   drift; tread slip within ``slip_tolerance`` of the commanded slip), or until ``drive_time`` has passed since the spin-up ended (then the summary says the
    run is not steady, and why). ``stop_when_steady=False`` drives the whole ``drive_time``.
 
 Measured quantities (wheel frame, from the contact resultant, time-averaged over each sample interval):
@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -65,7 +65,7 @@ from wheelsoil.granular.timestep import estimate_time_step
 from .contact import WheelContact, contact_material
 from .kinematics import TreadTracker, deformation, slip_angle_deg
 from .patch import MovingPatch, PatchGeometry
-from .steady import SteadyState, detect_steady_state, window_stats
+from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
 
 #: Series recorded at every sample, with units.
 SERIES_UNITS = {
@@ -127,6 +127,10 @@ class TestbedSpec:
         max(|mean|, floor) (floors: 5 % of W for forces, 5 % of W r for the torque, half a mean particle
         diameter for the sinkage).
     slip_tolerance: largest difference between the tread slip and the commanded slip in a steady window.
+    steady_checks: consecutive checks, one period of the tread apart, that must find the run steady before it
+        stops and is reported steady. The detector is asked again every period, so one lucky window would let
+        a drift comparable to its noise through sooner or later; two in a row cut that several-fold for a
+        period's more driving (``docs/steady-detector.md``).
     start_x: initial hub position along the bin [m] (default: one wheel radius plus 0.1 m from the start;
         on a periodic bed, as near the start as the moving patch allows).
     rigid: use the rigid wheel with the same surface instead of the flexible one.
@@ -163,6 +167,7 @@ class TestbedSpec:
     sample_interval: float = 0.005
     steady_tolerance: float = 0.1
     slip_tolerance: float = 0.03
+    steady_checks: int = 2
     start_x: float | None = None
     rigid: bool = False
     damping: float = 10.0
@@ -186,6 +191,9 @@ class TestbedSpec:
         for key in ("spin_up_time", "damping"):
             v = getattr(self, key)
             _check(key, v, fin(v) and v >= 0.0, f"{key} >= 0")
+        _check("steady_checks", self.steady_checks,
+               isinstance(self.steady_checks, int) and not isinstance(self.steady_checks, bool)
+               and 1 <= self.steady_checks <= 10, "an integer 1 <= steady_checks <= 10")
         _check("windup", self.windup, self.windup in ("controller", "none"), "'controller' or 'none'")
         _check("max_wind_up", self.max_wind_up, self.max_wind_up <= math.pi / 2, "max_wind_up <= pi/2 rad")
         _check("average_time", self.average_time, self.average_time < self.drive_time,
@@ -575,8 +583,12 @@ class Testbed:
             loop["next_check"] = t + self.pitch / s.angular_velocity
             ended = t >= loop["t_windup"] + s.drive_time - 1e-12
             if s.stop_when_steady or ended:
-                self.steady_state = self._detect()
-                done = self.steady_state.steady and self._window_long_enough(self.steady_state)
+                state = self._detect()
+                if state.steady and not self._window_long_enough(state):
+                    state = replace(state, steady=False, reasons=["the steady window is shorter than average_time"])
+                self.steady_state, loop["steady_in_a_row"] = confirm_steady(
+                    state, loop.get("steady_in_a_row", 0), s.steady_checks)
+                done = self.steady_state.steady
                 if (done and s.stop_when_steady) or ended:
                     return True
         return False

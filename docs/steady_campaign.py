@@ -3,7 +3,8 @@
 Each synthetic run is built like a smoke run of the testbed (``docs/coupling-trends.md``): the tread turns at
 1 rad/s with grousers every 30 deg, samples every 5 ms, the drive is held at t = 1.5 s and the detector is
 asked -- as :class:`wheelsoil.coupling.testbed.Testbed` asks it -- first one pitch plus ``average_time`` (1 s)
-after the hold and then once per pitch, until it calls the run steady or the drive ends at 8 s. Two quantities
+after the hold and then once per pitch, until it has called the run steady ``steady_checks`` times in a row or
+the drive ends at 8 s. Two quantities
 are checked together, with the floors and tolerance of the testbed at W = 3000 N:
 
 * a *value*, like the drawbar pull: 900 N settling from 600 N with a 0.4 s time constant;
@@ -20,8 +21,10 @@ successive difference). Scenarios:
 * the zero trends linearly from the hold on at a given rate [N/s].
 
 The detector runs with its default (``zero_within = 2``: a quantity indistinguishable from zero must not trend
-beyond 2 standard errors) and with the tolerance alone (``zero_within = 0``: every quantity must hold
-tolerance x max(|mean|, floor), the floor of a force being 5 % of W: +-15 N for the zero).
+beyond 2 standard errors; ``steady_checks = 2``: two steady verdicts in a row, one pitch apart, end the run),
+with one check only, and as it was before 2026-11-24: the tolerance alone (``zero_within = 0``: every quantity
+must hold tolerance x max(|mean|, floor), the floor of a force being 5 % of W: +-15 N for the zero) at one
+check.
 
 Usage (from the repository root; a few minutes on 2 CPU cores)::
 
@@ -35,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wheelsoil.coupling.steady import detect_steady_state
+from wheelsoil.coupling.steady import confirm_steady, detect_steady_state
 
 ROOT = Path(__file__).resolve().parent
 DT = 0.005  # sample interval [s]
@@ -79,12 +82,13 @@ def synthetic_run(seed: int, value_rate: float = 0.0, zero_rate: float = 0.0):
     return t, {"value": value, "zero": zero}, OMEGA * t
 
 
-def first_verdict(t, series, angle, zero_within: float):
-    """Ask the detector as the testbed does; the first steady state (or the last verdict at the drive's end)."""
+def first_verdict(t, series, angle, zero_within: float, checks: int):
+    """Ask the detector as the testbed does, ``checks`` steady verdicts in a row ending the run; the verdict
+    that ended it (or the last one at the drive's end)."""
     start = T_HOLD + PITCH / OMEGA
     check = start + AVERAGE_TIME
     speed = np.full(t.size, (1.0 - 0.3) * RADIUS * OMEGA)
-    state = None
+    state, in_a_row = None, 0
     for k in range(t.size):
         if t[k] < check - 1e-12:
             continue
@@ -95,10 +99,15 @@ def first_verdict(t, series, angle, zero_within: float):
             radius=RADIUS, pitch=PITCH, start=start, min_pitches=int(math.ceil(AVERAGE_TIME * OMEGA / PITCH)),
             tolerance=TOLERANCE, floors=FLOORS, slip_target=None, slip_tolerance=0.03, sample_interval=DT,
             zero_within=zero_within)
+        state, in_a_row = confirm_steady(state, in_a_row, checks)
         if state.steady:
             break
     return state
 
+
+#: (name, zero_within, steady_checks): the default, its parts, and the detector before 2026-11-24.
+DETECTORS = [("default: zero within noise, 2 checks", 2.0, 2), ("zero within noise, 1 check", 2.0, 1),
+             ("tolerance only, 1 check (before)", 0.0, 1)]
 
 SCENARIOS = [("stationary", {}), *[(f"value drifts {100 * r:g} %/s", {"value_rate": r})
                                    for r in (0.02, 0.05, 0.1, 0.2)],
@@ -108,11 +117,11 @@ SCENARIOS = [("stationary", {}), *[(f"value drifts {100 * r:g} %/s", {"value_rat
 def campaign(seeds: int) -> list[dict]:
     rows = []
     for name, kw in SCENARIOS:
-        for zero_within in (2.0, 0.0):
+        for rule, zero_within, checks in DETECTORS:
             steady, stop, err_value, err_zero, cover_value, cover_zero, noise_ratio, zero_flag = ([] for _ in range(8))
             for seed in range(seeds):
                 t, series, angle = synthetic_run(10_000 + seed, **kw)
-                st = first_verdict(t, series, angle, zero_within)
+                st = first_verdict(t, series, angle, zero_within, checks)
                 steady.append(st.steady)
                 if not st.steady:
                     continue
@@ -132,7 +141,7 @@ def campaign(seeds: int) -> list[dict]:
                 cover_zero.append(abs(sz["mean"] - true_zero) <= 2 * sz["sem"])
                 noise_ratio.append(sz["noise"] / SIGMA_ZERO)
                 zero_flag.append(sz["zero_within_noise"])
-            rows.append({"scenario": name, "zero_within": zero_within, "seeds": seeds,
+            rows.append({"scenario": name, "detector": rule, "seeds": seeds,
                          "steady": float(np.mean(steady)),
                          "stop_median": float(np.median(stop)) if stop else math.nan,
                          "value_error_p95": float(np.percentile(err_value, 95)) if err_value else math.nan,
@@ -171,8 +180,7 @@ def report(rows: list[dict], seeds: int, seconds: float) -> str:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        rule = "default (zero within noise)" if r["zero_within"] else "tolerance only"
-        lines.append(f"| {r['scenario']} | {rule} | {pct(r['steady'])} | {r['stop_median']:.2f} | "
+        lines.append(f"| {r['scenario']} | {r['detector']} | {pct(r['steady'])} | {r['stop_median']:.2f} | "
                      f"{100 * r['value_error_p95']:.1f} % | {r['zero_error_p95']:.0f} N | {pct(r['cover_value'])} | {pct(r['cover_zero'])} | "
                      f"{r['noise_ratio']:.2f} | {pct(r['zero_flag'])} |")
     return "\n".join(lines) + "\n"

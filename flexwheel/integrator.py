@@ -18,7 +18,7 @@ axis aligned with a global axis (a wheel's axle), an approximation otherwise.
 
 import taichi as ti
 
-from wheelsoil.taichi_types import nd_f64, nd_i32, nd_vec3, vec3
+from wheelsoil.taichi_types import nd_f64, nd_vec3, vec3
 
 from .rotation import exp_so3
 

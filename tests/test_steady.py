@@ -197,3 +197,24 @@ def test_a_zero_quantity_that_trends_is_not_steady_and_the_reason_names_it(seed)
     state = detect(t, series, angle, speed, floors={"drawbar_pull": 150.0, "lateral_force": 150.0})
     assert not state.steady
     assert any(r.startswith("lateral_force") for r in state.reasons), state.reasons
+
+
+def test_a_run_is_steady_only_at_the_required_number_of_steady_checks_in_a_row():
+    """confirm_steady: with two required, a first steady verdict is reported not steady (and says why), an
+    unsteady verdict resets the count, and the second steady verdict in a row is reported steady unchanged."""
+    from dataclasses import replace
+
+    from wheelsoil.coupling.steady import confirm_steady
+
+    t, series, angle, speed = synthetic_run(1)
+    good = detect(t, series, angle, speed)
+    assert good.steady
+    bad = replace(good, steady=False, reasons=["drawbar_pull drifts"])
+    verdicts, count = [], 0
+    for state in (good, bad, good, good, good):
+        out, count = confirm_steady(state, count, 2)
+        verdicts.append((out.steady, count))
+    assert verdicts == [(False, 1), (False, 0), (False, 1), (True, 2), (True, 3)]
+    first, _ = confirm_steady(good, 0, 2)
+    assert "1 check(s) in a row" in first.reasons[0] and first.stats is good.stats
+    assert confirm_steady(good, 0, 1)[0] is good  # one check: the verdict as it is
