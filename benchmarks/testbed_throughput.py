@@ -53,7 +53,7 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
 
 def smoke_part(steps: int, drive_time: float, arch) -> dict:
     from wheelsoil.cases.schema import load_case
-    from wheelsoil.coupling.testbed import Testbed
+    from wheelsoil.coupling.testbed import Testbed, soil_headroom
     from wheelsoil.granular import prepare_bed
 
     case = load_case("smoke-1g-steer", [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
@@ -112,8 +112,8 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
         "peak_rss_mib": own_peak_rss_mib(),
     })
     # the soil alone: the same bed in its own bin (periodic along x where the testbed holds a moving patch's
-    # ends instead) at the same step, without the wheel
-    soil = bed.to_scene(headroom=max(bed.spec.depth, 0.25), arch=arch)
+    # ends instead) at the same step and in the same domain, without the wheel
+    soil = bed.to_scene(headroom=soil_headroom(bed.spec.depth, case.wheel_geometry()), arch=arch)
     soil.time_step = bench.dt
     soil.step(10)  # compile
     t0, cpu0 = time.perf_counter(), time.process_time()

@@ -7,9 +7,9 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
     /series/<name>    1-D float64 datasets over time, attr units (coupling.testbed.SERIES_UNITS)
     /summary          attrs: <q>_mean, <q>_std, <q>_sem (standard error), <q>_drift, <q>_units for the
                       steady quantities (tread_slip among them); + <q>_drift_sem, <q>_zero_within_noise
-                      (bool: steady as a value indistinguishable from zero, coupling.steady); window_start, window_end [s], steady
-                      (bool), samples; + pitches (whole pitches of the tread in the window), pitch_deg,
-                      commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
+                      (bool: steady as a value indistinguishable from zero, coupling.steady); window_start,
+                      window_end [s], steady (bool), samples; + pitches (whole pitches of the tread in the
+                      window), pitch_deg, commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
     /run              + attrs: wall time, step counts, sizes (coupling.testbed.TestbedResult.info)
     /mesh/            nodes0 (N, 3) [m] (wheel in its start pose), triangles (T, 3), beams (B, 2)
     /frames/<k>/      attr t [s]; particles/{position, velocity (float32), radius}, wheel/{nodes,

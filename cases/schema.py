@@ -288,8 +288,8 @@ class CaseFile(BaseModel):
             drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
             windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
             sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
-            steady_checks=o.steady_checks, start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid, damping=self.wheel.damping,
-            axle_damping=t.axle_damping,
+            steady_checks=o.steady_checks, start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid,
+            damping=self.wheel.damping, axle_damping=t.axle_damping,
             pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
         )
 

@@ -30,7 +30,7 @@ That window is **steady** when every quantity passes one of two tests, and the t
   second halves differ by no more than that either. A drift beyond the tolerance fails even when it is within
   its own noise (the reason then says so): for a quantity with a value to hold, the detector does not call a
   window steady that it cannot tell from a drifting one;
-* *zero within its noise*: |mean| <= 2 sem, |drift| <= 2 drift_sem and the halves' difference within twice its
+* *zero within its noise*: |mean| < 2 sem, |drift| <= 2 drift_sem and the halves' difference within twice its
   standard error. A quantity whose value cannot be told from zero -- the lateral force of a straight run, whose
   expected value is zero by symmetry -- has no value for a relative tolerance to hold, and the floor (an
   absolute allowance) asks of its granular noise a precision no affordable window has: at smoke scale the
@@ -43,8 +43,10 @@ The tread is where the rig wants it when the tread slip over the window -- from 
 itself drift by more than ``slip_tolerance`` (the tread turns at the hub's rate: the wind-up has settled).
 If it is not steady, :func:`detect_steady_state` says which quantity failed and by how much.
 
-How often these tests call a stationary run unsteady, and a drifting one steady, is measured by a campaign of
-synthetic runs with the smoke runs' noise (``docs/steady_campaign.py`` -> ``docs/steady-detector.md``).
+A running testbed asks once per pitch and stops at the second steady verdict in a row
+(:func:`confirm_steady`). How often all this calls a stationary run unsteady, and a drifting one steady, is
+measured by a campaign of synthetic runs with the smoke runs' noise (``docs/steady_campaign.py`` ->
+``docs/steady-detector.md``).
 """
 
 from __future__ import annotations
@@ -170,8 +172,8 @@ def detect_steady_state(
     statistics; period_pitches: windows span a multiple of this many pitches (the wheel's whole period
     when spokes and grousers repeat at different pitches); start: earliest window start [s];
     floors: name -> floor of the relative tolerance; zero_within: standard errors within which a quantity
-    counts as zero within its noise (0: every quantity must hold the tolerance); slip_target: commanded slip (``None``: the
-    tread-slip criterion is skipped, e.g. to test the statistics alone).
+    counts as zero within its noise (0: every quantity must hold the tolerance); slip_target: commanded slip
+    (``None``: the tread-slip criterion is skipped, e.g. to test the statistics alone).
     """
     t = np.asarray(t, float)
     n = len(t)

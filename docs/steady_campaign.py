@@ -168,7 +168,7 @@ def report(rows: list[dict], seeds: int, seconds: float) -> str:
         f"Each row: {seeds} seeds (10000 onward).",
         "",
         "Columns: *steady* — runs called steady by the end of the drive (every other run ended \"not steady\");",
-        "*stop* — median end of the first steady window [s]; *value error p95* — 95th percentile of |reported",
+        "*stop* — median end of the window the run stopped at [s]; *value error p95* — 95th percentile of |reported",
         "value − the value's true level at the window's end| / that level (what a drift the detector lets through",
         "costs, beside the noise); *zero error p95* — the same for the zero, in N; *value/zero covered* — the true mean over the window within ±2 reported",
         "standard errors (95 % if the standard errors were exact);",
