@@ -146,3 +146,12 @@ def test_drawbar_pull_and_torque_rise_with_slip(mini_bed):
     for q in ("drawbar_pull", "torque"):
         (lo, e_lo), (hi, e_hi) = (_mean_and_error(runs[i], q) for i in (0.1, 0.6))
         assert hi - lo > 3.0 * np.hypot(e_lo, e_hi), (q, lo, e_lo, hi, e_hi)
+
+
+def test_the_soil_domain_holds_grains_carried_over_the_wheel_top(steering_run):
+    """Grains ride up in the grouser pockets: the soil's domain reaches above the standing wheel's top, so one
+    carried over it is not taken for a blown-up run."""
+    bench, _ = steering_run
+    surface = bench.bed.surface_height
+    top = surface + 2.0 * (MINI_WHEEL.radius + MINI_WHEEL.grouser_height)
+    assert bench.scene.domain_max[2] >= top + 0.1 - 1e-9
