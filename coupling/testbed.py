@@ -116,8 +116,8 @@ class TestbedSpec:
     spin_up_time: time over which omega (and the carriage speed) rise linearly [s].
     drive_time: longest drive after the spin-up [s]; the run ends sooner once steady (``stop_when_steady``).
     stop_when_steady: end the run at the first steady window of ``average_time``.
-    average_time: shortest averaging window once steady [s] (rounded up to whole periods of the tread, at
-        least three: :func:`wheel_period`).
+    average_time: shortest averaging window once steady [s] (rounded up to whole pitches of the tread, at
+        least three, and to two whole periods of the wheel: :func:`statistics_pitch`, :func:`wheel_period`).
     windup: ``"controller"`` (wind the wheel up by tread-speed feedback on the hub, then hold omega) or
         ``"none"`` (hold omega from the spin-up on).
     windup_gain: feedback gain K of the wind-up controller (> 0).
@@ -257,10 +257,19 @@ def soil_headroom(bed_depth: float, wheel: WheelGeometry) -> float:
 
 
 def wheel_period(wheel: WheelGeometry) -> float:
-    """The angle [rad] after which the wheel repeats itself: the grouser pitch and the spoke pitch both divide
-    it (their least common multiple when one is a whole multiple of the other, else the grouser pitch; the
-    spoke pitch for a smooth wheel). The batch of the steady-state statistics: the forces of a spoked wheel ride
-    on its periodic stiffness (seed 000 eq. 19) as well as on the grousers."""
+    """The angle [rad] after which the wheel repeats itself: the smallest rotation that maps the grousers onto
+    the grousers and the spokes onto the spokes, 2 pi / gcd(grousers, spokes around) (the spoke pitch for a
+    smooth wheel). The forces of a spoked wheel ride on its periodic stiffness (seed 000 eq. 19) as well as on
+    the grousers, so the steady-state windows span whole periods."""
+    spokes = int(round(360.0 / wheel.spoke_pitch))
+    return 2.0 * math.pi / (math.gcd(wheel.grouser_count, spokes) if wheel.grouser_count else spokes)
+
+
+def statistics_pitch(wheel: WheelGeometry) -> float:
+    """The batch angle [rad] of the steady-state statistics: the whole period (:func:`wheel_period`) when the
+    grouser and spoke pitches are whole multiples one of the other (the 24 grousers and 12 spokes of seed 004's
+    wheel: 30 deg), else the grouser pitch (8 grousers and 6 spokes: 45 deg, four to the 180-deg period),
+    which keeps a batch short enough for several per second of driving."""
     spoke = math.radians(wheel.spoke_pitch)
     if not wheel.grouser_count:
         return spoke
@@ -396,7 +405,8 @@ class Testbed:
         self.axle = self.yaw[:, 1]
         self.tracker = TreadTracker(mesh.nodes[self._tread_nodes], self.heading, self.axle,
                                     weights=self.structure.mass[self._tread_nodes])
-        self.pitch = wheel_period(wheel)
+        self.pitch = statistics_pitch(wheel)  # the batch of the steady-state statistics [rad]
+        self.period_pitches = int(round(wheel_period(wheel) / self.pitch))  # the wheel's whole period in batches
 
         # ---- the soil and the contact interface
         self.scene = bed.to_scene(headroom=soil_headroom(bs.depth, wheel), arch=arch, periodic_x=False, end_walls=self.patch is None)
@@ -628,23 +638,13 @@ class Testbed:
         return state.window[1] - state.window[0] >= self.spec.average_time * (1.0 - 1e-9)
 
     def _detect(self) -> SteadyState:
-        s, rows = self.spec, self.rows
-        series = {q: np.asarray(rows[q]) for q in STEADY_CHECKED}
-        d_mean = 0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max)
-        floors = {"drawbar_pull": 0.05 * s.load, "lateral_force": 0.05 * s.load, "vertical_force": 0.05 * s.load,
-                  "torque": 0.05 * s.load * self.wheel.radius, "sinkage": 0.5 * d_mean}
-        t = np.asarray(rows["t"])
-        # the tread angle from its per-sample spin, and the travel speed along the tread's heading (the v_x
-        # of the tread slip i_t = 1 - v_x / (r omega_t), recovered from the two series)
-        omega_t = np.asarray(rows["tread_omega"])
-        heading_speed = (1.0 - np.asarray(rows["tread_slip"])) * self.wheel.radius * omega_t
-        angle = np.cumsum(omega_t * self.steps_per_sample * self.dt)
-        min_pitches = int(math.ceil(s.average_time * s.angular_velocity / self.pitch))
-        return detect_steady_state(
-            t, series, tread_angle=angle, travel_speed=heading_speed, radius=self.wheel.radius, pitch=self.pitch,
-            start=self._loop.get("t_average_from", math.inf), min_pitches=min_pitches,
-            tolerance=s.steady_tolerance, floors=floors, slip_target=s.slip, slip_tolerance=s.slip_tolerance,
-            sample_interval=self.steps_per_sample * self.dt)
+        s = self.spec
+        return detect_from_rows(
+            self.rows, slip=s.slip, load=s.load, angular_velocity=s.angular_velocity, average_time=s.average_time,
+            steady_tolerance=s.steady_tolerance, slip_tolerance=s.slip_tolerance, radius=self.wheel.radius,
+            pitch=self.pitch, mean_diameter=0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max),
+            sample_interval=self.steps_per_sample * self.dt, start=self._loop.get("t_average_from", math.inf),
+            period_pitches=self.period_pitches)
 
     # ------------------------------------------------------------------ checkpoints
     def state(self) -> dict:
@@ -688,13 +688,15 @@ class Testbed:
         summary = {
             "steady": bool(state.steady), "window": [float(t[k0] - self.steps_per_sample * self.dt), float(t[k1 - 1])],
             "samples": int(k1 - k0), "pitches": int(state.pitches), "pitch_deg": math.degrees(self.pitch),
+            "period_pitches": self.period_pitches,
             "reasons": list(state.reasons), "commanded_slip": s.slip, "commanded_slip_angle": s.slip_angle,
         }
         for q in STEADY_QUANTITIES:
             y = rows[q][k0:k1]
             st = state.stats.get(q)
             if st is None and len(state.bounds) > 2 and (state.bounds[-1], state.bounds[0]) == (k0, k1):
-                st = window_stats(np.asarray(rows[q], float), state.bounds)  # batch means over the same pitches
+                # batch means over the same pitches
+                st = window_stats(np.asarray(rows[q], float), state.bounds, period=self.period_pitches)
             st = st or {}
             summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
                           "drift": float(st.get("drift", math.nan)), "drift_sem": float(st.get("drift_sem", math.nan)),
@@ -772,3 +774,35 @@ class _ProgressBar:
 
     def stop(self) -> None:
         self.bar.stop()
+
+
+def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: float, average_time: float,
+                     steady_tolerance: float, slip_tolerance: float, radius: float, pitch: float,
+                     mean_diameter: float, sample_interval: float, start: float, period_pitches: int = 1,
+                     truncation_search: float = 0.5) -> SteadyState:
+    """The testbed's steady-state verdict on its series ``rows`` (name -> per-sample values, the columns of
+    :data:`SERIES_UNITS`) -- what a running testbed asks once per pitch, and what a stored run's ``series.csv``
+    can be asked again (``docs/steady_replay.py``).
+
+    slip, load [N], angular_velocity [rad/s], average_time [s], steady_tolerance, slip_tolerance: the rig's
+    settings (:class:`TestbedSpec`); radius [m], pitch [rad] (the batch: :func:`statistics_pitch`) and
+    period_pitches (its whole period in batches): the wheel's; mean_diameter [m]: the soil's mean particle
+    diameter (half of it is the sinkage's floor); sample_interval [s]; start [s]: earliest window start.
+    The floors of the relative tolerance are 5 % of W for the forces, 5 % of W r for the torque.
+    truncation_search: see :func:`~.steady.detect_steady_state`.
+    """
+    series = {q: np.asarray(rows[q], float) for q in STEADY_CHECKED}
+    floors = {"drawbar_pull": 0.05 * load, "lateral_force": 0.05 * load, "vertical_force": 0.05 * load,
+              "torque": 0.05 * load * radius, "sinkage": 0.5 * mean_diameter}
+    t = np.asarray(rows["t"], float)
+    # the tread angle from its per-sample spin, and the travel speed along the tread's heading (the v_x
+    # of the tread slip i_t = 1 - v_x / (r omega_t), recovered from the two series)
+    omega_t = np.asarray(rows["tread_omega"], float)
+    heading_speed = (1.0 - np.asarray(rows["tread_slip"], float)) * radius * omega_t
+    angle = np.cumsum(omega_t * sample_interval)
+    min_pitches = int(math.ceil(average_time * angular_velocity / pitch))
+    return detect_steady_state(
+        t, series, tread_angle=angle, travel_speed=heading_speed, radius=radius, pitch=pitch, start=start,
+        min_pitches=min_pitches, tolerance=steady_tolerance, floors=floors, slip_target=slip,
+        slip_tolerance=slip_tolerance, sample_interval=sample_interval, period_pitches=period_pitches,
+        truncation_search=truncation_search)

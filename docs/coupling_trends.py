@@ -32,6 +32,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from steady_replay import replay  # docs/steady_replay.py, beside this script
 
 ROOT = Path(__file__).resolve().parent
 #: Seed 004 abstract: mean differences between 1g/W = 3000 N and 1/6 g/W = 500 N.
@@ -60,7 +61,9 @@ def run_case(name: str, preset: str, overrides: dict, runs: Path) -> Path:
 
     A finished run that was steady is reused whatever drive it was allowed, as long as that was no longer than
     :data:`DRIVE_TIME`: it stopped when it became steady, and a longer allowance takes it through the same
-    steps to the same stop (the runs are deterministic)."""
+    steps to the same stop (the runs are deterministic). A run is reused only if the installed detector, asked
+    again about its stored series (``steady_replay.py``), gives the same verdict over the same window: a run
+    that a changed detector would have stopped elsewhere is run again."""
     out = runs / name
     summary = out / "summary.json"
     if summary.exists():
@@ -69,8 +72,12 @@ def run_case(name: str, preset: str, overrides: dict, runs: Path) -> Path:
         wanted = dict(overrides, stop_when_steady=True)
         same = all(tb.get(k) == v for k, v in wanted.items())
         if same and (tb.get("drive_time") == DRIVE_TIME or (meta["summary"]["steady"] and tb["drive_time"] <= DRIVE_TIME)):
-            print(f"[{name}] reusing {summary}")
-            return out
+            state, _, _ = replay(out)
+            stored = meta["summary"]
+            if state.steady == stored["steady"] and np.allclose(state.window, stored["window"], atol=1e-9):
+                print(f"[{name}] reusing {summary} (the detector, asked again, gives the same window)")
+                return out
+            print(f"[{name}] the detector now gives another verdict or window on the stored series: running again")
     cmd = [sys.executable, "-m", "wheelsoil.cases.cli", "run", preset, "--slip", str(overrides["slip"]),
            "--slip-angle", str(overrides["slip_angle"]), "--set", f"test.drive_time={DRIVE_TIME!r}", "--out", str(out)]
     if overrides.get("rigid"):

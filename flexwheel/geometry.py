@@ -107,10 +107,19 @@ class WheelGeometry:
 
     @property
     def spoke_pitch(self) -> float:
-        """Angle [deg] after which the spoke layout repeats (60 deg for six virtual spokes)."""
+        """Angle [deg] after which the spoke layout repeats (60 deg for six virtual spokes): the smallest
+        rotation 360/d (d dividing the number of distinct spoke angles) that maps the spoke angles onto
+        themselves -- two rows of 12 staggered by 15 deg repeat every 15 deg, by 10 deg every 30 deg."""
         angles = sorted({round((row.angle + 360.0 * k / self.spokes_per_row) % 360.0, 9)
                          for row in self.spoke_rows for k in range(self.spokes_per_row)})
-        return 360.0 / len(angles)
+        n = len(angles)
+        present = np.array(angles)
+        for d in sorted((d for d in range(1, n + 1) if n % d == 0), reverse=True):
+            shifted = (present + 360.0 / d) % 360.0
+            gap = np.abs(shifted[:, None] - present[None, :])
+            if np.all(np.min(np.minimum(gap, 360.0 - gap), axis=1) < 1e-6):
+                return 360.0 / d
+        return 360.0
 
     def with_element_size(self, size: float) -> "WheelGeometry":
         return replace(self, element_size=float(size))

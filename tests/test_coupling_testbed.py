@@ -155,3 +155,29 @@ def test_the_soil_domain_holds_grains_carried_over_the_wheel_top(steering_run):
     surface = bench.bed.surface_height
     top = surface + 2.0 * (MINI_WHEEL.radius + MINI_WHEEL.grouser_height)
     assert bench.scene.domain_max[2] >= top + 0.1 - 1e-9
+
+
+@pytest.mark.parametrize("grousers, spokes, rows, period, batch", [
+    (24, 12, (0.0, 0.0), 30.0, 30.0),   # seed 004's wheel: the spokes' pitch is two grouser pitches
+    (8, 6, (0.0,), 180.0, 45.0),        # the mini wheel: grousers and spokes meet again after 180 deg
+    (0, 12, (0.0,), 30.0, 30.0),        # smooth: the spokes alone
+    (12, 12, (0.0, 15.0), 30.0, 30.0),  # two rows staggered by half a pitch: spokes every 15 deg
+    (24, 12, (0.0, 10.0), 30.0, 30.0),  # staggered by 10 deg: the spoke layout repeats every 30 deg only
+    (7, 5, (0.0,), 360.0, 360.0 / 7),   # nothing in common: one whole turn
+])
+def test_the_wheel_period_maps_grousers_and_spokes_onto_themselves(grousers, spokes, rows, period, batch):
+    """wheel_period is 360 deg / gcd(grousers, spokes around); the statistics' batch is the period when one
+    pitch is a multiple of the other, else the grouser pitch, and always divides the period."""
+    from wheelsoil.coupling.testbed import statistics_pitch, wheel_period
+    from wheelsoil.flexwheel.geometry import SpokeRow
+
+    n = len(rows)
+    from wheelsoil.flexwheel.geometry import LUNAR_ROVER
+
+    wheel = replace(LUNAR_ROVER, grouser_count=grousers, spokes_per_row=spokes,
+                    spoke_rows=tuple(SpokeRow(y_min=-0.5 + k / n, y_max=-0.5 + (k + 1) / n, angle=a)
+                                     for k, a in enumerate(rows)))
+    assert np.degrees(wheel_period(wheel)) == pytest.approx(period)
+    assert np.degrees(statistics_pitch(wheel)) == pytest.approx(batch)
+    ratio = wheel_period(wheel) / statistics_pitch(wheel)
+    assert ratio == pytest.approx(round(ratio))

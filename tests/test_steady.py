@@ -218,3 +218,75 @@ def test_a_run_is_steady_only_at_the_required_number_of_steady_checks_in_a_row()
     first, _ = confirm_steady(good, 0, 2)
     assert "1 check(s) in a row" in first.reasons[0] and first.stats is good.stats
     assert confirm_steady(good, 0, 1)[0] is good  # one check: the verdict as it is
+
+
+def test_mser_searches_only_the_first_half_so_a_stationary_run_keeps_a_long_window():
+    """Six stationary quantities over 24 pitches: searched to the end, the latest MSER truncation cuts most such
+    runs to a window of a few pitches (the last means happen to lie close together); searched over the first
+    half (MSER's own rule), every window keeps at least half the pitches. 40 draws, each asserted."""
+    short_before = 0
+    for seed in range(40):
+        t, series, angle, speed = synthetic_run(900 + seed, t_end=6.5, tau=0.01)
+        for q in range(5):
+            series[f"q{q}"] = 100.0 + zero_quantity(900 + 10 * seed + q, t, angle, sigma=5.0)
+        floors = {name: 150.0 for name in series}
+        kw = dict(floors=floors, slip_target=None, zero_within=0.0, tolerance=1.0)
+        n_pitches = len(pitch_boundaries(angle, len(t), PITCH, 1)) - 1
+        state = detect(t, series, angle, speed, **kw)
+        assert state.pitches >= n_pitches // 2, (seed, state.pitches, n_pitches)
+        short_before += detect(t, series, angle, speed, truncation_search=1.0, **kw).pitches < n_pitches // 2
+    assert short_before >= 20  # the rule the first half replaces: about 84 % of such runs cut short
+
+
+def test_a_transient_longer_than_half_the_run_is_not_called_steady():
+    """A force still settling (time constant 2 s over a 4 s run): MSER may not cut it out of the window beyond
+    the first half, so the window holds the rise and its drift fails the tolerance."""
+    for seed in (1, 2, 3):
+        t, series, angle, speed = synthetic_run(seed, tau=2.0)
+        state = detect(t, series, angle, speed)
+        assert not state.steady
+        assert any(r.startswith("drawbar_pull") for r in state.reasons), state.reasons
+
+
+#: A pattern repeating every 4 pitches, like the mini run's drawbar pull (pitch means about +3, +6, -3, -5 N on
+#: 11 N: 8 grousers and 6 spokes repeat together every 180 deg), scaled by 10.
+PATTERN = np.array([30.0, 60.0, -35.0, -55.0])
+
+
+def periodic_pattern(angle, levels):
+    """Pitch means following ``levels`` around the period, pitches counted back from the last sample."""
+    pitch_of = np.floor((angle[-1] - angle) / PITCH).astype(int)
+    return np.asarray(levels)[pitch_of % len(levels)]
+
+
+def test_periodic_trend_recovers_a_slope_under_a_pattern_that_repeats_every_period():
+    """Noise-free pitch means: a line plus a pattern repeating every 4 pitches over 12 pitches. The analysis of
+    covariance slope is the line's exactly (the plain least-squares line is not: the pattern's phases correlate
+    with time in a window of whole periods), and with period 1 it equals the least-squares slope."""
+    from wheelsoil.coupling.steady import periodic_trend
+
+    x = np.arange(12, dtype=float)
+    pattern = np.tile([5.0, 8.0, -3.0, -6.0], 3)
+    slope, factor = periodic_trend(0.7 * x + pattern, 4)
+    assert slope == pytest.approx(0.7, abs=1e-12)
+    assert np.polyfit(x, 0.7 * x + pattern, 1)[0] != pytest.approx(0.7, abs=0.05)
+    # S = sum over 4 phases of sum (x - xbar_p)^2, each phase 3 points 4 apart: 4 * 16 * 2 = 128
+    assert factor == pytest.approx(1.0 / math.sqrt(128.0), rel=1e-12)
+    y = np.random.default_rng(3).normal(size=12)
+    assert periodic_trend(y, 1)[0] == pytest.approx(np.polyfit(x, y, 1)[0], rel=1e-10)
+
+
+@pytest.mark.parametrize("seed", [21, 22, 23, 24])
+def test_a_pattern_every_four_pitches_is_not_taken_for_noise_or_drift(seed):
+    """A stationary force whose pitch means ride on a pattern repeating every 4 pitches (PATTERN, against white
+    pitch-mean noise of 20 N): told the period, the detector's noise is the noise (within 40 %, one draw) and
+    the run is steady over whole periods; told nothing, the noise takes in the pattern (over 1.5 x)."""
+    t, series, angle, speed = synthetic_run(seed, t_end=6.0, tau=0.01)
+    force = 1000.0 + zero_quantity(seed, t, angle, sigma=20.0) + periodic_pattern(angle, PATTERN)
+    series = {"drawbar_pull": force}
+    state = detect(t, series, angle, speed, period_pitches=4)
+    assert state.steady, state.reasons
+    assert state.pitches % 4 == 0 and state.pitches >= 8
+    assert state.stats["drawbar_pull"]["noise"] == pytest.approx(20.0, rel=0.4)
+    blind = detect(t, series, angle, speed)
+    assert blind.stats["drawbar_pull"]["noise"] > 1.5 * 20.0
