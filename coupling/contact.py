@@ -270,11 +270,6 @@ class WheelContact(Interaction):
         """Physical sphere--wheel contacts at the last evaluation."""
         return int(self._n_contacts)
 
-    @property
-    def active_particles(self) -> int:
-        """Spheres within reach of the wheel (with candidate facets) since the last rebuild."""
-        return int(self._n_active) if self._arrays else 0
-
     def resultant(self) -> tuple[np.ndarray, np.ndarray]:
         """Force [N] of the soil on the wheel and its moment [N m] about the hub centre, last evaluation."""
         r = self._resultant.to_numpy()
