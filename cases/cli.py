@@ -383,7 +383,9 @@ def summary_lines(s: dict) -> list[str]:
     with their standard errors, and the tread's slip beside the commanded one."""
     span = f"t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s"
     if s["steady"]:
-        head = f"[green]steady[/] over {span} ({s.get('pitches', 0)} pitches of {s.get('pitch_deg', 0):.1f} deg):"
+        period = s.get("period_pitches", 1)
+        periods = f", {s.get('pitches', 0) // period} wheel periods of {period * s.get('pitch_deg', 0):.0f} deg" if period > 1 else ""
+        head = f"[green]steady[/] over {span} ({s.get('pitches', 0)} pitches of {s.get('pitch_deg', 0):.1f} deg{periods}):"
     else:
         head = f"[yellow]NOT steady[/]: averaged the last window, {span}, for information only:"
     lines = [head]
