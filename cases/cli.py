@@ -12,6 +12,7 @@ Exit codes (scripts can trust them):
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -391,9 +392,10 @@ def summary_lines(s: dict) -> list[str]:
     lines = [head]
     for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
         st = s[q]
-        sem = st.get("sem", float("nan"))
+        sem, ci = st.get("sem", float("nan")), st.get("ci95", float("nan"))
         zero = ": zero within its noise, no trend" if st.get("zero_within_noise") else ""
-        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}, fluctuation "
+        interval = f", 95 % interval +-{ci:.2g}" if math.isfinite(ci) else ""
+        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}{interval}, fluctuation "
                      f"{st['std']:.3g}{zero})")
     if "tread_slip" in s:
         lines.append(f"  {'tread slip':16s} {s['tread_slip']['mean']:10.4f}      (commanded {s.get('commanded_slip', float('nan')):g}; "

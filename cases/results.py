@@ -6,8 +6,10 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
                       created; + case_name, case_hash, bed, complete (True only in a finished file)
     /series/<name>    1-D float64 datasets over time, attr units (coupling.testbed.SERIES_UNITS)
     /summary          attrs: <q>_mean, <q>_std, <q>_sem (standard error), <q>_drift, <q>_units for the
-                      steady quantities (tread_slip among them); + <q>_drift_sem, <q>_zero_within_noise
-                      (bool: steady as a value indistinguishable from zero, coupling.steady); window_start,
+                      steady quantities (tread_slip among them); + <q>_ci95 (half-width of the mean's 95 %
+                      confidence interval, Student's t), <q>_dof (its degrees of freedom), <q>_drift_sem,
+                      <q>_zero_within_noise (bool: steady as a value indistinguishable from zero,
+                      coupling.steady); window_start,
                       window_end [s], steady (bool), samples; + pitches (whole pitches of the tread in the
                       window), pitch_deg, commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
     /run              + attrs: wall time, step counts, sizes (coupling.testbed.TestbedResult.info)
@@ -40,7 +42,7 @@ from wheelsoil.errors import WheelsoilInputError
 
 FRAME_FORMAT = "{:06d}"
 #: The statistics a summary keeps for each steady quantity.
-SUMMARY_STATS = ("mean", "std", "sem", "drift", "drift_sem", "zero_within_noise", "units")
+SUMMARY_STATS = ("mean", "std", "sem", "ci95", "dof", "drift", "drift_sem", "zero_within_noise", "units")
 
 
 def partial_path(path: str | Path) -> Path:

@@ -15,6 +15,10 @@ rolling wheel):
   squared change per pitch, so the whole drive informs the noise, not just the two or three degrees of
   freedom of a short window's own pitch means;
 * ``sem``: the standard error of the window's mean, noise / sqrt(m) over its m pitches;
+* ``ci95``: the half-width of the window mean's 95 % confidence interval, t(0.975, dof) sem, with Student's t at
+  the noise estimate's degrees of freedom ``dof`` (:func:`pitch_noise_dof`: a run that stops at its first
+  steady window has estimated its noise from five or six pitch means, and +-2 sem then covers the true mean in
+  about 84 % of stationary synthetic runs, not 95 %; ``docs/steady-detector.md``);
 * ``drift``: the change over the window of the least-squares line through the pitch means, and
   ``drift_sem`` its standard error, noise sqrt(12 (m - 1) / (m (m + 1))) (the slope's variance
   12 sigma^2 / (m (m^2 - 1)), times (m - 1)^2).
@@ -71,6 +75,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.stats import t as student_t
 
 
 @dataclass
@@ -81,7 +86,7 @@ class SteadyState:
     k0, k1: sample indices of the window, [k0, k1) (the averaged samples).
     window: (t_start, t_end) [s] of the window (t_start is the start of the first sample's interval).
     pitches: whole pitches of the tread's rotation in the window.
-    stats: per quantity ``{"mean", "std", "sem", "drift"}`` over the window.
+    stats: per quantity ``{"mean", "std", "sem", "dof", "ci95", "drift", ...}`` over the window.
     tread_slip, tread_slip_sem: the tread slip from the window's mean spin and its standard error.
     reasons: why the best candidate window is not steady (empty when steady).
     bounds: the sample indices of the window's pitch boundaries, latest first (for :func:`window_stats` of
@@ -138,6 +143,27 @@ def pitch_noise(batches: np.ndarray, lag: int = 1) -> float:
     return float(math.sqrt(float(np.sum((b[lag:] - b[:-lag]) ** 2)) / (2.0 * (len(b) - lag))))
 
 
+def pitch_noise_dof(n: int, lag: int = 1) -> float:
+    """Degrees of freedom nu of :func:`pitch_noise`'s variance estimate from ``n`` independent normal pitch means
+    at lag L, matched to a chi-square's (nu = 2 sigma^4 / Var(sigma_hat^2)). For L = 1 the mean square successive
+    difference q of n values has Var(q) = sigma^4 (3n - 4) / (n - 1)^2 (von Neumann, Kent, Bellinson & Hart 1941,
+    Ann. Math. Stat. 12, 153, eq. for the variance of delta^2 / 2), so nu = 2 (n - 1)^2 / (3n - 4), about two
+    thirds of the n - 1 of the sample variance. At lag L the differences form L independent chains, one per phase;
+    their variances add to sigma^4 (3n - 4L) / (n - L)^2, so nu = 2 (n - L)^2 / (3n - 4L). 0 with no pair L apart."""
+    lag = max(1, int(lag))
+    pairs = int(n) - lag
+    if pairs <= 0:
+        return 0.0
+    return 2.0 * pairs * pairs / (3.0 * pairs - lag)
+
+
+def t_quantile(dof: float, level: float = 0.95) -> float:
+    """Two-sided Student-t quantile t((1 + level) / 2, dof); inf for dof <= 0 (no noise estimate)."""
+    if not dof > 0:
+        return math.inf
+    return float(student_t.ppf(0.5 + 0.5 * level, dof))
+
+
 #: Standard errors a zero-within-noise quantity's mean, drift and halves may lie within (about 95 % each).
 ZERO_WITHIN = 2.0
 
@@ -159,19 +185,23 @@ def periodic_trend(means: np.ndarray, period: int = 1) -> tuple[float, float]:
     return (num / den, 1.0 / math.sqrt(den)) if den > 0 else (0.0, math.inf)
 
 
-def window_stats(y: np.ndarray, bounds: list[int], noise: float | None = None, period: int = 1) -> dict:
+def window_stats(y: np.ndarray, bounds: list[int], noise: float | None = None, period: int = 1,
+                 noise_dof: float | None = None) -> dict:
     """Mean, standard deviation, standard errors and drift of ``y`` over the window [bounds[-1], bounds[0])
     split at the pitch boundaries ``bounds`` (descending), with the pitch means' scatter ``noise`` (default:
     :func:`pitch_noise` of the window's own pitch means at lag ``period``). ``period``: the wheel's period in
     pitches; the window should span whole periods, so that a pattern repeating every period drops out of the
     mean, of the drift (:func:`periodic_trend`) and of the change between its halves (whole periods each).
-    See the module docstring for the formulas."""
+    ``noise_dof``: the degrees of freedom of a given ``noise`` (default: those of the window's own pitch means);
+    ``ci95`` is Student's t at them times ``sem``. See the module docstring for the formulas."""
     k0, k1 = bounds[-1], bounds[0]
     period = max(1, int(period))
     seg = y[k0:k1]
     means = np.array([y[b1:b0].mean() for b0, b1 in zip(bounds[:-1], bounds[1:])])[::-1]  # in time order
     m = len(means)
     sigma = pitch_noise(means, period) if noise is None else float(noise)
+    if noise_dof is None:
+        noise_dof = pitch_noise_dof(m, period) if noise is None else math.inf
     sem = sigma / math.sqrt(m) if m > 1 else math.inf
     drift, drift_sem, step, step_sem = 0.0, math.inf, 0.0, math.inf
     slope, factor = periodic_trend(means, period)
@@ -181,7 +211,8 @@ def window_stats(y: np.ndarray, bounds: list[int], noise: float | None = None, p
     if 0 < half < m:
         step = float(means[half:].mean() - means[:half].mean())
         step_sem = sigma * math.sqrt(1.0 / half + 1.0 / (m - half))
-    return {"mean": float(seg.mean()), "std": float(seg.std()), "noise": sigma, "sem": sem, "drift": drift,
+    return {"mean": float(seg.mean()), "std": float(seg.std()), "noise": sigma, "sem": sem,
+            "dof": float(noise_dof), "ci95": t_quantile(noise_dof) * sem, "drift": drift,
             "drift_sem": drift_sem, "step": step, "step_sem": step_sem}
 
 
@@ -259,8 +290,11 @@ def detect_steady_state(
     # MSER truncation: the latest start any quantity needs, searched over the first half of the pitches since
     # the earliest start and keeping at least min_pitches (a truncation in the second half is the noise of a
     # few close pitch means, not a transient's end: see the module docstring)
+    # (a quantity constant to round-off -- the tread slip of a rigid wheel -- has no transient, and its MSER
+    # truncation would be decided by the last digits of its samples: it is left out)
     latest = min(n_pitches - min_pitches, int(truncation_search * n_pitches))
-    start_pitch = max(mser_truncation(deseasonalised(b, period_pitches), latest) for b in batches.values())
+    start_pitch = max([mser_truncation(deseasonalised(b, period_pitches), latest)
+                       for b in batches.values() if varies(b)], default=0)
     m = (n_pitches - start_pitch) // period_pitches * period_pitches
     b = bounds[: m + 1]
     k0, k1 = b[-1], b[0]
@@ -268,7 +302,8 @@ def detect_steady_state(
     # see a slow transient only through its change per pitch, and a window's few pitches alone would give
     # the noise with two or three degrees of freedom
     noise = {name: pitch_noise(bm, period_pitches) for name, bm in batches.items()}
-    stats = {name: window_stats(np.asarray(y, float), b, noise=noise[name], period=period_pitches)
+    dof = pitch_noise_dof(n_pitches, period_pitches)
+    stats = {name: window_stats(np.asarray(y, float), b, noise=noise[name], period=period_pitches, noise_dof=dof)
              for name, y in series.items()}
     reasons = []
     for name, st in stats.items():
@@ -292,7 +327,9 @@ def detect_steady_state(
     slip_noise = noise.get("tread_slip", pitch_noise(per_pitch_slip[w], period_pitches))
     slip_sem = slip_noise / math.sqrt(m)
     slip_drift = periodic_trend(per_pitch_slip[w], period_pitches)[0] * (m - 1)
-    stats["tread_slip"] = {"mean": slip, "std": float(np.std(per_pitch_slip[w])), "sem": slip_sem, "drift": slip_drift}
+    slip_dof = dof if "tread_slip" in noise else pitch_noise_dof(m, period_pitches)
+    stats["tread_slip"] = {"mean": slip, "std": float(np.std(per_pitch_slip[w])), "sem": slip_sem, "dof": slip_dof,
+                           "ci95": t_quantile(slip_dof) * slip_sem, "drift": slip_drift}
     if slip_target is not None:
         if not abs(slip - slip_target) <= slip_tolerance:
             reasons.append(f"tread slip {slip:.3f} differs from the commanded {slip_target:.3f} by more "
@@ -317,6 +354,17 @@ def confirm_steady(state: SteadyState, in_a_row: int, required: int) -> tuple[St
         state = replace(state, steady=False, reasons=[
             f"steady at {in_a_row} check(s) in a row, one period apart; {required} are required (steady_checks)"])
     return state, in_a_row
+
+
+#: Relative spread of pitch means below which a quantity counts as constant (round-off of float64 sums).
+CONSTANT_SPREAD = 1e-9
+
+
+def varies(batches: np.ndarray) -> bool:
+    """Whether pitch means differ by more than round-off: their spread exceeds :data:`CONSTANT_SPREAD` times
+    their largest magnitude (a commanded value, such as a rigid wheel's tread slip, does not)."""
+    b = np.asarray(batches, float)
+    return bool(b.size and np.ptp(b) > CONSTANT_SPREAD * max(float(np.max(np.abs(b))), 1e-300))
 
 
 def mser_truncation(batches: np.ndarray, latest: int) -> int:

@@ -699,6 +699,7 @@ class Testbed:
                 st = window_stats(np.asarray(rows[q], float), state.bounds, period=self.period_pitches)
             st = st or {}
             summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
+                          "ci95": float(st.get("ci95", math.nan)), "dof": float(st.get("dof", math.nan)),
                           "drift": float(st.get("drift", math.nan)), "drift_sem": float(st.get("drift_sem", math.nan)),
                           "units": SERIES_UNITS[q]}
             if "zero_within_noise" in st:
@@ -708,7 +709,7 @@ class Testbed:
             summary["tread_slip"] = {**{k: float(v) for k, v in ts.items()}, "units": "1"}
         else:
             summary["tread_slip"] = {"mean": float(np.mean(rows["tread_slip"][k0:k1])),
-                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan,
+                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan, "ci95": math.nan,
                                      "drift": math.nan, "units": "1"}
         particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
         nodes = self.structure.positions()

@@ -82,8 +82,8 @@ def main() -> None:
                    help="take every batch for a whole period of the wheel (the detector before)")
     args = p.parse_args()
     print("| run | stored: steady, window [s] | replayed: steady | window [s] | pitches | DP [N] | F_y [N] "
-          "| tread slip | reasons |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| 95 % interval DP / F_y [N] (dof) | tread slip | reasons |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for run_dir in args.runs:
         stored = json.loads((run_dir / "summary.json").read_text())["summary"]
         state, _, _ = replay(run_dir, args.truncation_search, not args.batch_is_period)
@@ -92,7 +92,9 @@ def main() -> None:
               f"{stored['window'][0]:.2f}–{stored['window'][1]:.2f} | {'yes' if state.steady else 'no'} | "
               f"{state.window[0]:.2f}–{state.window[1]:.2f} | {state.pitches} | "
               f"{dp.get('mean', math.nan):.1f} ± {dp.get('sem', math.nan):.1f} | "
-              f"{fy.get('mean', math.nan):.1f} ± {fy.get('sem', math.nan):.1f} | {state.tread_slip:.3f} | "
+              f"{fy.get('mean', math.nan):.1f} ± {fy.get('sem', math.nan):.1f} | "
+              f"±{dp.get('ci95', math.nan):.1f} / ±{fy.get('ci95', math.nan):.1f} ({dp.get('dof', math.nan):.1f}) | "
+              f"{state.tread_slip:.3f} | "
               f"{'; '.join(state.reasons)} |", flush=True)
 
 

@@ -7,7 +7,15 @@ import math
 import numpy as np
 import pytest
 
-from wheelsoil.coupling.steady import detect_steady_state, pitch_boundaries
+from wheelsoil.coupling.steady import (
+    detect_steady_state,
+    pitch_boundaries,
+    pitch_noise,
+    pitch_noise_dof,
+    t_quantile,
+    varies,
+    window_stats,
+)
 
 DT = 0.005  # sample interval [s]
 OMEGA = 1.0  # tread spin [rad/s]
@@ -290,3 +298,57 @@ def test_a_pattern_every_four_pitches_is_not_taken_for_noise_or_drift(seed):
     assert state.stats["drawbar_pull"]["noise"] == pytest.approx(20.0, rel=0.4)
     blind = detect(t, series, angle, speed)
     assert blind.stats["drawbar_pull"]["noise"] > 1.5 * 20.0
+
+
+@pytest.mark.parametrize("n, lag", [(6, 1), (12, 2), (16, 4)])
+def test_pitch_noise_dof_matches_the_variance_of_the_noise_estimate(n, lag):
+    """nu = 2 sigma^4 / Var(sigma_hat^2) for pitch_noise of n independent normal means (von Neumann et al. 1941,
+    generalised to L independent chains): the Monte Carlo variance over 20,000 series agrees within 8 %
+    (its own sampling error is under 2 %), for three seeds each."""
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        q = np.array([pitch_noise(rng.normal(size=n), lag) ** 2 for _ in range(20_000)])
+        assert q.mean() == pytest.approx(1.0, rel=0.03)  # unbiased
+        assert 2.0 / q.var() == pytest.approx(pitch_noise_dof(n, lag), rel=0.08)
+
+
+@pytest.mark.parametrize("n, m, lag", [(6, 4, 1), (12, 6, 1), (16, 8, 2)])
+def test_the_95_percent_interval_covers_the_true_mean_where_two_standard_errors_do_not(n, m, lag):
+    """Independent normal pitch means, the noise from all n of them, the window the last m: the reported ci95
+    (Student's t at pitch_noise_dof) covers the true mean in 95 % of 4,000 series (93-98 % allowed: binomial
+    error 0.35 %, and the chi-square match is slightly conservative for few pitches), where +-2 standard errors
+    cover it in under 94 % (88 % at n = 6)."""
+    for seed in range(3):
+        rng = np.random.default_rng(100 + seed)
+        covered_t = covered_2 = 0
+        bounds = list(range(n, n - m - 1, -1))  # one sample per pitch, latest boundary first
+        for _ in range(4000):
+            b = rng.normal(size=n)
+            st = window_stats(b, bounds, noise=pitch_noise(b, lag), period=lag, noise_dof=pitch_noise_dof(n, lag))
+            covered_t += abs(st["mean"]) <= st["ci95"]
+            covered_2 += abs(st["mean"]) <= 2.0 * st["sem"]
+        assert 0.93 <= covered_t / 4000 <= 0.98
+        assert covered_2 / 4000 < 0.94
+
+
+def test_the_interval_widens_to_infinity_without_a_noise_estimate():
+    assert pitch_noise_dof(1, 1) == 0.0 and t_quantile(0.0) == math.inf
+    assert t_quantile(1e9) == pytest.approx(1.95996, abs=1e-4)
+
+
+def test_a_quantity_constant_to_round_off_does_not_choose_the_window():
+    """A rigid wheel's tread slip is the commanded one to the last digits, and MSER on such pitch means picks its
+    truncation from round-off: a run's verdict then changed between the live testbed (full float64 rows) and
+    its series.csv (10 digits). With the tread slip's travel speed perturbed at the 1e-15 level in three ways,
+    the window is the same each time, and it is the window chosen by the force alone."""
+    for seed in (21, 22, 23):
+        t, series, angle, speed = synthetic_run(seed, tau=0.05)
+        alone = detect(t, series, angle, speed, slip_target=None)
+        windows = set()
+        for k in range(3):
+            wobble = 1.0 + 1e-15 * np.random.default_rng(100 * seed + k).standard_normal(t.size)
+            state = detect(t, series, angle, speed * wobble)
+            windows.add((state.k0, state.k1))
+        assert windows == {(alone.k0, alone.k1)}
+    assert not varies(np.full(8, 0.3) + 1e-16 * np.arange(8)) and varies(np.array([0.3, 0.3001]))
+    assert not varies(np.zeros(5))
