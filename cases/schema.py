@@ -242,7 +242,8 @@ class CaseFile(BaseModel):
     def bed_spec(self):
         """The :class:`~wheelsoil.granular.BedSpec` of the soil section."""
         from wheelsoil.granular.bed import BedSpec
-        from wheelsoil.granular.materials import Material, PairProperties
+        from wheelsoil.granular.materials import PairProperties
+        from wheelsoil.material import Material
 
         s = self.soil
         return BedSpec(
@@ -258,7 +259,7 @@ class CaseFile(BaseModel):
         from dataclasses import replace
 
         from wheelsoil.flexwheel.geometry import SpokeRow, preset
-        from wheelsoil.flexwheel.material import ElasticMaterial
+        from wheelsoil.material import Material
 
         w = self.wheel
         base = preset(w.preset)
@@ -270,10 +271,11 @@ class CaseFile(BaseModel):
             changes["spoke_rows"] = tuple(SpokeRow(*row) for row in w.spoke_rows)
         if any(v is not None for v in (w.youngs_modulus, w.poisson_ratio, w.density)):
             m = base.material
-            changes["material"] = ElasticMaterial(
-                w.youngs_modulus if w.youngs_modulus is not None else m.youngs_modulus,
-                w.poisson_ratio if w.poisson_ratio is not None else m.poisson_ratio,
-                w.density if w.density is not None else m.density, name=f"{base.name} material (case)")
+            changes["material"] = Material(
+                f"{base.name} material (case)",
+                youngs_modulus=w.youngs_modulus if w.youngs_modulus is not None else m.youngs_modulus,
+                poisson_ratio=w.poisson_ratio if w.poisson_ratio is not None else m.poisson_ratio,
+                density=w.density if w.density is not None else m.density)
         return replace(base, **changes)
 
     def testbed_spec(self):

@@ -69,12 +69,6 @@ from .surface import ContactSurface
 HISTORY_SLOTS = 4
 
 
-def contact_material(wheel_material) -> Material:
-    """The wheel's elastic material (``flexwheel`` ElasticMaterial) as the contact law's :class:`Material`."""
-    wm = wheel_material
-    return Material(wm.name, youngs_modulus=wm.youngs_modulus, poisson_ratio=wm.poisson_ratio, density=wm.density)
-
-
 class WheelContact(Interaction):
     """Contact between the spheres of a scene and the surface facets of a wheel structure.
 
@@ -110,7 +104,7 @@ class WheelContact(Interaction):
             raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
         self.structure = structure
         self.surface = ContactSurface.from_mesh(structure.mesh)
-        wheel = contact_material(structure.mesh.material)
+        wheel = structure.mesh.material
         self.soil = soil
         self.pair = pair
         self.e_eff = effective_modulus(soil, wheel)

@@ -63,7 +63,7 @@ from wheelsoil.granular.bed import Bed, BedSpec, check_memory, machine_memory
 from wheelsoil.granular.materials import SOIL_STEEL, PairProperties, effective_modulus
 from wheelsoil.granular.timestep import estimate_time_step
 
-from .contact import WheelContact, contact_material
+from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
 from .patch import MovingPatch, PatchGeometry
 from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
@@ -298,7 +298,7 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     # a lower bound of the run's DEM step: the smallest possible radius, and the walls' and the wheel's contacts
     # beside the pairs (the scene's estimate uses the spheres' actual smallest radius, never below it)
     moduli = (effective_modulus(bed.material, bed.wall_material),
-              effective_modulus(bed.material, contact_material(wheel.material)))
+              effective_modulus(bed.material, wheel.material))
     shortest = spec.time_step or estimate_time_step(0.5 * bed.diameter_min, bed.material, wall_moduli=moduli).stable
     if spec.sample_interval < shortest:
         raise WheelsoilInputError(f"output.sample_interval = {spec.sample_interval:.3g} s is shorter than the "

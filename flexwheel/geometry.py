@@ -23,7 +23,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 
 from .beam import rectangular_section
-from .material import SEED004_WHEEL, SPRING_STEEL, ElasticMaterial
+from .material import SEED004_WHEEL, SPRING_STEEL, Material
 from .mesh import StructureMesh
 from .shapes import grid_triangles
 
@@ -57,7 +57,7 @@ class WheelGeometry:
     grouser_height: float = 0.0
     grouser_thickness: float = 0.0
     grouser_angle: float = 0.0
-    material: ElasticMaterial = field(default_factory=lambda: SEED004_WHEEL)
+    material: Material = field(default_factory=lambda: SEED004_WHEEL)
     element_size: float = 0.02
     hub_mass: float = 0.0
     nominal_load: float = 0.0

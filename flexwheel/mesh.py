@@ -8,6 +8,7 @@ surface (the tread and grousers of a wheel). Nothing here knows about Taichi.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 
-from .material import ElasticMaterial
+from .material import Material
 from .shell_stiffness import DRILLING_PENALTY
 
 
@@ -52,7 +53,7 @@ class StructureMesh:
     nodes: np.ndarray
     triangles: np.ndarray
     thickness: np.ndarray | float
-    material: ElasticMaterial
+    material: Material
     beams: np.ndarray | None = None
     beam_section: np.ndarray | None = None
     beam_orientation: np.ndarray | None = None
@@ -62,6 +63,10 @@ class StructureMesh:
     drilling_penalty: float = DRILLING_PENALTY
 
     def __post_init__(self) -> None:
+        if not math.isfinite(self.material.youngs_modulus):
+            raise WheelsoilInputError(
+                f"material {self.material.name!r}: youngs_modulus E = {self.material.youngs_modulus!r} Pa: the wheel's "
+                "finite elements need a finite modulus (a rigid wheel is wheel.rigid = true)")
         self.nodes = _as_array("nodes", self.nodes, float, (3,), allow_empty=False)
         n = len(self.nodes)
         self.triangles = _as_array("triangles", self.triangles, np.int64, (3,))

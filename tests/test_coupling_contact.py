@@ -15,12 +15,9 @@ from wheelsoil.flexwheel.material import SEED004_WHEEL
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.shapes import strip
 from wheelsoil.flexwheel.structure import Structure
-from wheelsoil.granular import LUNAR_SOIL_SIMULANT, SOIL_STEEL, Material, PairProperties, Scene
+from wheelsoil.granular import LUNAR_SOIL_SIMULANT, SOIL_STEEL, PairProperties, Scene
 from wheelsoil.granular.materials import effective_modulus
 from wheelsoil.taichi_types import to_ndarray, vec3
-
-WHEEL_STEEL = Material("wheel", youngs_modulus=SEED004_WHEEL.youngs_modulus,
-                       poisson_ratio=SEED004_WHEEL.poisson_ratio, density=SEED004_WHEEL.density)
 
 
 def test_closest_point_matches_brute_force_and_names_the_region():
@@ -68,7 +65,7 @@ def _drop(position, velocity, *, on_plate, pair, radius=0.01, steps=1500, dt=1e-
         st.drive_hub(velocity=(0, 0, 0), angular_velocity=(0, 0, 0))
         scene.add_interaction(WheelContact(st, LUNAR_SOIL_SIMULANT, pair))
     else:
-        scene.add_wall((0, 0, 0), (0, 0, 1), material=WHEEL_STEEL, pair=pair)
+        scene.add_wall((0, 0, 0), (0, 0, 1), material=SEED004_WHEEL, pair=pair)
     scene.time_step = dt
     z, fz = [], []
     for _ in range(steps):
@@ -92,7 +89,7 @@ def test_sphere_on_a_triangulated_plate_is_the_sphere_on_a_wall_and_hertz(xy):
     assert np.max(np.abs(f_plate - f_wall)) < 1e-9 * f_wall.max()
     # Hertz (Johnson, Contact Mechanics, eq. 11.24): delta_max = (15 m v^2 / (16 E* sqrt(R)))^(2/5)
     m = LUNAR_SOIL_SIMULANT.density * 4 / 3 * math.pi * r**3
-    e_star = effective_modulus(LUNAR_SOIL_SIMULANT, WHEEL_STEEL)
+    e_star = effective_modulus(LUNAR_SOIL_SIMULANT, SEED004_WHEEL)
     delta = (15 * m * v0**2 / (16 * e_star * math.sqrt(r))) ** 0.4
     f_max = 4 / 3 * e_star * math.sqrt(r) * delta**1.5
     assert f_plate.max() == pytest.approx(f_max, rel=0.01)

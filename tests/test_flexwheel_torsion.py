@@ -10,11 +10,11 @@ import pytest
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import LUNAR_ROVER, SpokeRow, WheelGeometry
-from wheelsoil.flexwheel.material import ElasticMaterial
+from wheelsoil.material import Material
 from wheelsoil.flexwheel.torsion import spoked_wheel_torsion_stiffness, torsion_test
 
 #: nu = 0, so that a plate strip in cylindrical bending has the beam's rigidity E b t^3 / 12 exactly.
-STEEL_NU0 = ElasticMaterial(200e9, 0.0, 7850.0, name="steel, nu = 0")
+STEEL_NU0 = Material("steel, nu = 0", youngs_modulus=200e9, poisson_ratio=0.0, density=7850.0)
 #: Six straight (unbowed) spokes across the whole width: the closed form's wheel.
 SPOKED = WheelGeometry(name="spoked", radius=0.3, width=0.1, tread_thickness=0.004, hub_radius=0.06,
                        spokes_per_row=6, spoke_thickness=0.003, spoke_rows=(SpokeRow(-0.5, 0.5, 0.0),),

@@ -11,14 +11,14 @@ from scipy.spatial.transform import Rotation
 
 from wheelsoil.flexwheel.beam import rectangular_section
 from wheelsoil.flexwheel.linear import assemble_stiffness
-from wheelsoil.flexwheel.material import ElasticMaterial
+from wheelsoil.material import Material
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.shapes import beam_ring, cylinder_band, strip
 from wheelsoil.flexwheel.statics import relax
 from wheelsoil.flexwheel.structure import Structure, critical_frequency
 
 # Sze, Liu & Lo (2004), Finite Elem. Anal. Des. 40, 1551: cantilever strip, E = 1.2e6, nu = 0, t = 0.1
-SZE = ElasticMaterial(1.2e6, 0.0, 1.0, name="Sze et al. strip")
+SZE = Material("Sze et al. strip", youngs_modulus=1.2e6, poisson_ratio=0.0, density=1.0)
 B, T = 1.0, 0.1
 EI = 1.2e6 * B * T**3 / 12
 
@@ -223,7 +223,7 @@ def test_undamped_free_vibration_conserves_energy_and_momentum():
     """A free strip set spinning and vibrating: total energy constant within 0.5 % over several
     vibration periods (central difference: bounded, O(dt^2) fluctuation); linear momentum exact."""
     nodes, tri = strip(1.0, 0.2, 10, 2)
-    mesh = StructureMesh(nodes, tri, 0.01, ElasticMaterial(2e11, 0.3, 7850.0))
+    mesh = StructureMesh(nodes, tri, 0.01, Material("steel", 2e11, 0.3, 7850.0))
     s = Structure(mesh)
     spin = np.array([0.0, 0.0, 30.0])
     v = np.cross(spin, nodes - nodes.mean(axis=0))

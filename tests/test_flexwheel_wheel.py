@@ -1,6 +1,7 @@
 """The parametric wheel, its hub, the rigid variant, the coupling interface, bad input and the command."""
 
 import json
+import math
 from dataclasses import replace
 
 import meshio
@@ -11,7 +12,7 @@ from wheelsoil.cases.cli import main
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 from wheelsoil.flexwheel.geometry import EXOMARS, LUNAR_ROVER, SpokeRow, build_wheel_mesh, preset
 from wheelsoil.flexwheel.loadtest import plate_load_curve, point_load_stiffness
-from wheelsoil.flexwheel.material import ElasticMaterial
+from wheelsoil.material import Material
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
 
@@ -136,10 +137,12 @@ def test_bad_geometry_is_refused_with_the_key_and_value(change, match):
 
 def test_bad_material_mesh_and_step_are_refused():
     with pytest.raises(WheelsoilInputError, match="youngs_modulus"):
-        ElasticMaterial(0.0, 0.3, 7850.0)
+        Material("m", 0.0, 0.3, 7850.0)
     with pytest.raises(WheelsoilInputError, match="poisson_ratio"):
-        ElasticMaterial(1e9, 0.5, 7850.0)
-    mat = ElasticMaterial(1e9, 0.3, 1000.0)
+        Material("m", 1e9, 0.5, 7850.0)
+    with pytest.raises(WheelsoilInputError, match="finite modulus"):
+        StructureMesh(np.eye(3), [[0, 1, 2]], 0.01, Material("rigid", math.inf, 0.3, 7850.0))
+    mat = Material("m", 1e9, 0.3, 1000.0)
     nodes = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], float)
     with pytest.raises(WheelsoilInputError, match="degenerate"):
         StructureMesh(nodes, [[0, 1, 2]], 0.01, mat)
