@@ -73,6 +73,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import numpy as np
 from scipy.stats import t as student_t
@@ -157,8 +158,10 @@ def pitch_noise_dof(n: int, lag: int = 1) -> float:
     return 2.0 * pairs * pairs / (3.0 * pairs - lag)
 
 
+@lru_cache(maxsize=1024)
 def t_quantile(dof: float, level: float = 0.95) -> float:
-    """Two-sided Student-t quantile t((1 + level) / 2, dof); inf for dof <= 0 (no noise estimate)."""
+    """Two-sided Student-t quantile t((1 + level) / 2, dof); inf for dof <= 0 (no noise estimate). Cached: a
+    run asks for the same few degrees of freedom at every check."""
     if not dof > 0:
         return math.inf
     return float(student_t.ppf(0.5 + 0.5 * level, dof))
