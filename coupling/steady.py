@@ -195,8 +195,8 @@ def window_stats(y: np.ndarray, bounds: list[int], noise: float | None = None, p
     :func:`pitch_noise` of the window's own pitch means at lag ``period``). ``period``: the wheel's period in
     pitches; the window should span whole periods, so that a pattern repeating every period drops out of the
     mean, of the drift (:func:`periodic_trend`) and of the change between its halves (whole periods each).
-    ``noise_dof``: the degrees of freedom of a given ``noise`` (default: those of the window's own pitch means);
-    ``ci95`` is Student's t at them times ``sem``. See the module docstring for the formulas."""
+    ``noise_dof``: the degrees of freedom of ``noise`` (default: those of the window's own pitch means when
+    ``noise`` is not given, else infinite, a normal quantile); ``ci95`` is Student's t at them times ``sem``. See the module docstring for the formulas."""
     k0, k1 = bounds[-1], bounds[0]
     period = max(1, int(period))
     seg = y[k0:k1]

@@ -281,6 +281,11 @@ def statistics_pitch(wheel: WheelGeometry) -> float:
     return grouser
 
 
+def batches_per_period(wheel: WheelGeometry) -> int:
+    """The wheel's whole period (:func:`wheel_period`) in batches of the statistics (:func:`statistics_pitch`)."""
+    return int(round(wheel_period(wheel) / statistics_pitch(wheel)))
+
+
 def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     """Check, before any bed is prepared, that the bed and the wheel mesh fit the machine's memory, that the
     time step and the load are ones the contact model can take, that the wheel fits the bin and that the bin
@@ -406,7 +411,7 @@ class Testbed:
         self.tracker = TreadTracker(mesh.nodes[self._tread_nodes], self.heading, self.axle,
                                     weights=self.structure.mass[self._tread_nodes])
         self.pitch = statistics_pitch(wheel)  # the batch of the steady-state statistics [rad]
-        self.period_pitches = int(round(wheel_period(wheel) / self.pitch))  # the wheel's whole period in batches
+        self.period_pitches = batches_per_period(wheel)  # the wheel's whole period in batches
 
         # ---- the soil and the contact interface
         self.scene = bed.to_scene(headroom=soil_headroom(bs.depth, wheel), arch=arch, periodic_x=False, end_walls=self.patch is None)
@@ -709,7 +714,7 @@ class Testbed:
             summary["tread_slip"] = {**{k: float(v) for k, v in ts.items()}, "units": "1"}
         else:
             summary["tread_slip"] = {"mean": float(np.mean(rows["tread_slip"][k0:k1])),
-                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan, "ci95": math.nan,
+                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan, "ci95": math.nan, "dof": math.nan,
                                      "drift": math.nan, "units": "1"}
         particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
         nodes = self.structure.positions()

@@ -64,9 +64,9 @@ def run_case(name: str, preset: str, overrides: dict, runs: Path) -> Path:
 
     A finished run that was steady is reused whatever drive it was allowed, as long as that was no longer than
     its own (``overrides["drive_time"]``, else :data:`DRIVE_TIME`): it stopped when it became steady, and a
-    longer allowance takes it through the same steps to the same stop (the runs are deterministic). A run is reused only if the installed detector, asked
-    again about its stored series (``steady_replay.py``), gives the same verdict over the same window: a run
-    that a changed detector would have stopped elsewhere is run again."""
+    longer allowance takes it through the same steps to the same stop (the runs are deterministic). A run is
+    reused only if the installed detector, asked again about its stored series (``steady_replay.py``), gives the
+    same verdict over the same window: a run that a changed detector would have stopped elsewhere is run again."""
     out = runs / name
     drive = overrides.get("drive_time", DRIVE_TIME)
     summary = out / "summary.json"

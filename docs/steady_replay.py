@@ -25,7 +25,7 @@ import numpy as np
 
 from wheelsoil.cases.schema import load_case
 from wheelsoil.coupling.steady import confirm_steady
-from wheelsoil.coupling.testbed import detect_from_rows, statistics_pitch, wheel_period
+from wheelsoil.coupling.testbed import batches_per_period, detect_from_rows, statistics_pitch
 
 
 def read_series(path: Path) -> dict:
@@ -48,7 +48,7 @@ def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = 
     t = rows["t"]
     dt_sample = float(t[1] - t[0])
     pitch = statistics_pitch(wheel)
-    period_pitches = int(round(wheel_period(wheel) / pitch)) if whole_periods else 1
+    periods = batches_per_period(wheel) if whole_periods else 1
     batch_time = pitch / spec.angular_velocity
     start = run["t_hold"] + batch_time
     check, end = start + spec.average_time, run["t_wind_up"] + spec.drive_time
@@ -56,7 +56,7 @@ def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = 
                   average_time=spec.average_time, steady_tolerance=spec.steady_tolerance,
                   slip_tolerance=spec.slip_tolerance, radius=wheel.radius, pitch=pitch,
                   mean_diameter=0.5 * (bed.diameter_min + bed.diameter_max), sample_interval=dt_sample, start=start,
-                  period_pitches=period_pitches)
+                  period_pitches=periods)
     state, in_a_row, checks, t_check = None, 0, 0, math.nan
     for k in range(len(t)):
         if t[k] < check - 1e-12:

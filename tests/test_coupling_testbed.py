@@ -168,7 +168,7 @@ def test_the_soil_domain_holds_grains_carried_over_the_wheel_top(steering_run):
 def test_the_wheel_period_maps_grousers_and_spokes_onto_themselves(grousers, spokes, rows, period, batch):
     """wheel_period is 360 deg / gcd(grousers, spokes around); the statistics' batch is the period when one
     pitch is a multiple of the other, else the grouser pitch, and always divides the period."""
-    from wheelsoil.coupling.testbed import statistics_pitch, wheel_period
+    from wheelsoil.coupling.testbed import batches_per_period, statistics_pitch, wheel_period
     from wheelsoil.flexwheel.geometry import SpokeRow
 
     n = len(rows)
@@ -181,3 +181,4 @@ def test_the_wheel_period_maps_grousers_and_spokes_onto_themselves(grousers, spo
     assert np.degrees(statistics_pitch(wheel)) == pytest.approx(batch)
     ratio = wheel_period(wheel) / statistics_pitch(wheel)
     assert ratio == pytest.approx(round(ratio))
+    assert batches_per_period(wheel) == round(period / batch)
