@@ -49,7 +49,7 @@ def bench_spec(args):
     return BedSpec(
         length=args.length, width=args.width, depth=args.depth,
         diameter_min=0.016, diameter_max=0.024, gravity=(0.0, 0.0, -9.81),
-        wall_material=LUNAR_SOIL_SIMULANT, wall_pair=SOIL_SOIL, seed=1,
+        wall_material=LUNAR_SOIL_SIMULANT, wall_pair=SOIL_SOIL, seed=1, periodic=False,
     )
 
 

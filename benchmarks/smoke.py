@@ -42,8 +42,10 @@ DEFAULT_HISTORY = Path("benchmarks/history/smoke.jsonl")
 
 def smoke_bed_spec():
     from wheelsoil.granular import BedSpec
+    from wheelsoil.parameters import seed004
 
-    return BedSpec(length=0.5, width=0.4, depth=0.15, seed=7)
+    return BedSpec(length=0.5, width=0.4, depth=0.15, diameter_min=seed004.PARTICLE_DIAMETER_MIN,
+                   diameter_max=seed004.PARTICLE_DIAMETER_MAX, seed=7, periodic=False)
 
 
 def figure(value: float, units: str, *, reference_s: float, higher_is_better: bool, gated: bool,

@@ -52,15 +52,16 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
 
 
 def smoke_part(steps: int, drive_time: float, arch) -> dict:
+    from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed, soil_headroom
     from wheelsoil.granular import prepare_bed
 
     case = load_case("smoke-1g-steer", [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
                                         f"output.average_time={min(0.1, 0.5 * drive_time)!r}"])
-    bed = prepare_bed(case.bed_spec(), arch=arch)
+    bed = prepare_bed(build.bed_spec(case), arch=arch)
     t0 = time.perf_counter()
-    bench = Testbed(bed, case.wheel_geometry(), case.testbed_spec(), arch=arch)
+    bench = Testbed(bed, build.wheel_geometry(case), build.testbed_spec(case), arch=arch)
     setup = time.perf_counter() - t0
     cpu0 = time.process_time()
     result = bench.run()
@@ -113,7 +114,7 @@ def smoke_part(steps: int, drive_time: float, arch) -> dict:
     })
     # the soil alone: the same bed in its own bin (periodic along x where the testbed holds a moving patch's
     # ends instead) at the same step and in the same domain, without the wheel
-    soil = bed.to_scene(headroom=soil_headroom(bed.spec.depth, case.wheel_geometry()), arch=arch)
+    soil = bed.to_scene(headroom=soil_headroom(bed.spec.depth, build.wheel_geometry(case)), arch=arch)
     soil.time_step = bench.dt
     soil.step(10)  # compile
     t0, cpu0 = time.perf_counter(), time.process_time()
@@ -182,9 +183,10 @@ def _child(part: str, arch, steps: int, *, drive_time: float | None = None, env:
 
 def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
     """Seed-004 cost from the measured smoke-scale parts and the measured full-resolution wheel."""
+    from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
 
-    s_bed, f_bed = load_case("smoke-1g-steer").bed_spec(), load_case("seed004-1g-steer").bed_spec()
+    s_bed, f_bed = build.bed_spec(load_case("smoke-1g-steer")), build.bed_spec(load_case("seed004-1g-steer"))
     # the DEM step scales with the smallest radius (Rayleigh and Hertz estimates are both ~ R)
     dt = smoke["dem_time_step_s"] * f_bed.diameter_min / s_bed.diameter_min
     particles = SEED004_PARTICLES / smoke["particles"]

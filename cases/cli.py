@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 from wheelsoil.gravity import GRAVITY_PRESETS
+from wheelsoil.parameters import smoke
 
 EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
@@ -51,7 +52,8 @@ hold the semi-empirical model against measured data and name what it misses:
 
 or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
-    wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --gravity moon --out moon_bed.h5
+    wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --dmin 0.016 --dmax 0.024 --gravity moon \
+        --out moon_bed.h5
     wheelsoil render moon_bed.h5 --out moon_bed.png
 """
 
@@ -70,8 +72,11 @@ def _gravity(value: str) -> float:
     return g
 
 
-BED_DEFAULTS = {"length": 0.5, "width": 0.25, "depth": 0.1, "dmin": 0.016, "dmax": 0.024,
-                "gravity": GRAVITY_PRESETS["earth"], "seed": 0}
+#: prepare-bed's defaults without a CASE: the smoke run's bed (the parameter set every layer takes its defaults
+#: from), so that ``wheelsoil prepare-bed`` makes the bed ``wheelsoil run`` uses.
+BED_DEFAULTS = {"length": smoke.SOIL["length"], "width": smoke.SOIL["width"], "depth": smoke.SOIL["depth"],
+                "dmin": smoke.SOIL["diameter_min"], "dmax": smoke.SOIL["diameter_max"],
+                "gravity": GRAVITY_PRESETS[smoke.GRAVITY], "seed": smoke.SEED}
 
 
 def _add_bed_options(p: argparse.ArgumentParser) -> None:
@@ -80,12 +85,16 @@ def _add_bed_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--length", type=float, default=None, help=f"bin length along x [m] (default {d['length']})")
     g.add_argument("--width", type=float, default=None, help=f"bin width along y [m] (default {d['width']})")
     g.add_argument("--depth", type=float, default=None, help=f"levelled bed depth [m] (default {d['depth']})")
-    g.add_argument("--dmin", type=float, default=None, help="smallest particle diameter [m] (default 0.016, seed 004)")
-    g.add_argument("--dmax", type=float, default=None, help="largest particle diameter [m] (default 0.024, seed 004)")
+    g.add_argument("--dmin", type=float, default=None,
+                   help=f"smallest particle diameter [m] (default {d['dmin']}; seed 004: 0.016)")
+    g.add_argument("--dmax", type=float, default=None,
+                   help=f"largest particle diameter [m] (default {d['dmax']}; seed 004: 0.024)")
     g.add_argument("--gravity", type=_gravity, default=None,
-                   help="'earth' (9.81), 'moon' (9.81/6) or a value in m/s^2 (default earth); "
+                   help=f"'earth' (9.81), 'moon' (9.81/6) or a value in m/s^2 (default {smoke.GRAVITY}); "
                         "beds are prepared under the gravity they are tested at")
-    g.add_argument("--seed", type=int, default=None, help="random seed of radii and packing (default 0)")
+    g.add_argument("--seed", type=int, default=None, help=f"random seed of radii and packing (default {d['seed']})")
+    g.add_argument("--walled", action="store_true",
+                   help="end walls instead of a bin periodic along its length (the default, as the smoke run's)")
     p.add_argument("--no-cache", action="store_true", help="prepare afresh even if an identical bed is cached")
     p.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
 
@@ -93,19 +102,21 @@ def _add_bed_options(p: argparse.ArgumentParser) -> None:
 def _spec_from_args(args):
     from wheelsoil.granular import BedSpec
 
-    given = [k for k in BED_DEFAULTS if getattr(args, k) is not None]
+    given = [k for k in BED_DEFAULTS if getattr(args, k) is not None] + (["walled"] if args.walled else [])
     if getattr(args, "case", None):
         if given:
             raise _InputError(f"--{given[0]} does not go with a CASE: set the case's soil instead, e.g. "
                               f"--set soil.length=1.0 ('wheelsoil case show {args.case}' lists the keys)")
+        from . import build
         from .schema import load_case
 
-        return load_case(args.case, args.set or []).bed_spec()
+        return build.bed_spec(load_case(args.case, args.set or []))
     if args.set:
         raise _InputError("--set needs a CASE (e.g. wheelsoil prepare-bed smoke-1g-steer --set soil.gravity=moon)")
     v = {k: (getattr(args, k) if getattr(args, k) is not None else BED_DEFAULTS[k]) for k in BED_DEFAULTS}
     return BedSpec(length=v["length"], width=v["width"], depth=v["depth"], diameter_min=v["dmin"],
-                   diameter_max=v["dmax"], gravity=(0.0, 0.0, -v["gravity"]), seed=v["seed"])
+                   diameter_max=v["dmax"], gravity=(0.0, 0.0, -v["gravity"]), seed=v["seed"],
+                   periodic=not args.walled)
 
 
 def _add_set_option(p: argparse.ArgumentParser, help: str = "override a case key (repeatable)") -> None:

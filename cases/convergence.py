@@ -43,6 +43,7 @@ from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.granular.bed import estimated_particles
 from wheelsoil.provenance import atomic_output
 
+from . import build
 from .results import load_result
 from .run import RESULT_NAME
 from .schema import CaseError, CaseFile, apply_overrides, validate_case
@@ -103,11 +104,11 @@ def plan(study: ConvergenceStudy) -> list[dict]:
     """Before anything runs: each level's estimated particle count (:func:`~wheelsoil.granular.bed.
     estimated_particles`) and the soil's cost per simulated second relative to the reference (particles x steps per second;
     the stable DEM step is proportional to the smallest radius, and a time-step level's step is its scale)."""
-    ref = study.base.bed_spec()
+    ref = build.bed_spec(study.base)
     n_ref = estimated_particles(ref)
     out = []
     for lv in study.cases() + [lv for lvs in study.levels.values() for lv in lvs if lv.case is None]:
-        spec = (lv.case or study.base).bed_spec()
+        spec = build.bed_spec(lv.case or study.base)
         n = estimated_particles(spec)
         steps = ref.diameter_min / spec.diameter_min / (lv.scale if lv.factor == "time_step" else 1.0)
         out.append({"factor": lv.factor, "scale": lv.scale, "particles": int(round(n)),
@@ -138,7 +139,7 @@ def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_st
     if factor == "width":
         return {"soil.width": s.width * scale}
     if factor == "mesh":
-        size = w.element_size if w.element_size is not None else case.wheel_geometry().element_size
+        size = w.element_size if w.element_size is not None else build.wheel_geometry(case).element_size
         return {"wheel.element_size": size * scale}
     if factor == "time_step":
         if scale == 1.0:
@@ -229,7 +230,7 @@ def run_study(study: ConvergenceStudy, *, workers: int = 1, arch: str | None = N
 # -------------------------------------------------------------------- report
 def _floors(case: CaseFile) -> dict:
     w = case.test.load
-    r = case.wheel_geometry().radius
+    r = build.wheel_geometry(case).radius
     d = 0.5 * (case.soil.diameter_min + case.soil.diameter_max)
     return {"drawbar_pull": 0.05 * w, "lateral_force": 0.05 * w, "vertical_force": 0.05 * w, "torque": 0.05 * w * r,
             "sinkage": 0.5 * d, "tread_slip": 0.01}

@@ -178,6 +178,13 @@ class Result:
 
         return case_from_toml(self.attrs["case_toml"], f"{self.path} (case_toml)")
 
+    @property
+    def wheel(self):
+        """The :class:`~wheelsoil.flexwheel.geometry.WheelGeometry` this result's wheel was made from."""
+        from .build import wheel_geometry
+
+        return wheel_geometry(self.case)
+
     def steady(self, name: str) -> float:
         """Steady-state mean of a quantity."""
         return float(self.summary[name]["mean"])

@@ -30,6 +30,7 @@ from wheelsoil.flexwheel.geometry import estimated_elements
 from wheelsoil.granular.bed import estimated_particles
 from wheelsoil.provenance import atomic_output, provenance, writable_folder
 
+from . import build
 from .results import ResultWriter, attr_value, partial_path
 from .schema import CaseFile, case_to_toml
 
@@ -91,8 +92,8 @@ def output_bytes(case: CaseFile) -> int:
     total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
     o = case.output
     frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
-    particles = estimated_particles(case.bed_spec())
-    per_frame = particles * 7 * 8 + estimated_elements(case.wheel_geometry()) * 6 * 8
+    particles = estimated_particles(build.bed_spec(case))
+    per_frame = particles * 7 * 8 + estimated_elements(build.wheel_geometry(case)) * 6 * 8
     return frames * per_frame + 2 * particles * 30 * 8
 
 
@@ -139,10 +140,10 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
         ckpt_path.unlink(missing_ok=True)
         partial_path(result_path).unlink(missing_ok=True)
 
-    bed = prepare_bed(case.bed_spec(), cache_dir=bed_cache, progress=progress, arch=arch)
+    bed = prepare_bed(build.bed_spec(case), cache_dir=bed_cache, progress=progress, arch=arch)
     say(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
-    spec = case.testbed_spec()
-    bench = Testbed(bed, case.wheel_geometry(), spec, arch=arch)
+    spec = build.testbed_spec(case)
+    bench = Testbed(bed, build.wheel_geometry(case), spec, arch=arch)
     say(f"wheel {case.wheel.preset}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
         f"{'rigid' if spec.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; slip {spec.slip:g}, "
         f"steering {spec.slip_angle:g} deg, W = {spec.load:g} N")

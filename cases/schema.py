@@ -32,9 +32,16 @@ from typing import Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator
 
+from wheelsoil.coupling.testbed import TestbedSpec, check_fits
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.flexwheel.geometry import WheelGeometry
+from wheelsoil.granular.bed import BedSpec
 from wheelsoil.gravity import GRAVITY_PRESETS
+from wheelsoil.material import Material, PairProperties
+from wheelsoil.parameters import smoke
+from wheelsoil.ranges import Range, non_negative
 
+from . import build
 from .units import UnitError, to_unit
 
 if sys.version_info >= (3, 11):
@@ -52,9 +59,16 @@ class CaseError(WheelsoilInputError):
         super().__init__(head + "\n  ".join(problems))
 
 
-def _q(default, unit: str, description: str, **limits):
-    """A field with a unit (documented and converted from strings) and range limits."""
+def _q(default, unit: str, description: str, rng: Range | None = None):
+    """A field with a unit (documented and converted from strings) and the range ``rng`` -- the solver spec's own
+    (``TestbedSpec.RANGES``, ``BedSpec.RANGES``, ...), so that the case and the API check the same bounds."""
+    limits = rng.limits() if rng is not None else {}
     return Field(default, description=description, json_schema_extra={"unit": unit}, **limits)
+
+
+_TEST, _BED, _WHEEL = TestbedSpec.RANGES, BedSpec.RANGES, WheelGeometry.RANGES
+_MATERIAL, _PAIR = Material.RANGES, PairProperties.RANGES
+_SOIL_MATERIAL, _SOIL_PAIR, _CONTACT = smoke.SOIL_MATERIAL, smoke.SOIL_SOIL, smoke.CONTACT
 
 
 class _Section(BaseModel):
@@ -77,32 +91,37 @@ class CaseInfo(_Section):
     name: Optional[str] = Field(None, description="run name (default: the file name without .toml)",
                                 min_length=1, max_length=120, pattern=r"^[A-Za-z0-9._+-]+$")
     description: str = Field("", description="free text kept with the result")
-    seed: int = Field(0, ge=0, description="random seed of the bed's particle radii and packing")
+    seed: int = Field(smoke.SEED, description="random seed of the bed's particle radii and packing",
+                      **_BED["seed"].limits())
 
 
 class Soil(_Section):
-    length: float = _q(2.0, "m", "bin length along the travel direction", gt=0)
-    width: float = _q(0.9, "m", "bin width across the travel direction", gt=0)
-    depth: float = _q(0.2, "m", "levelled bed depth", gt=0)
-    diameter_min: float = _q(0.025, "m", "smallest particle diameter (uniform distribution)", gt=0)
-    diameter_max: float = _q(0.0375, "m", "largest particle diameter", gt=0)
+    length: float = _q(smoke.SOIL["length"], "m", "bin length along the travel direction", _BED["length"])
+    width: float = _q(smoke.SOIL["width"], "m", "bin width across the travel direction", _BED["width"])
+    depth: float = _q(smoke.SOIL["depth"], "m", "levelled bed depth", _BED["depth"])
+    diameter_min: float = _q(smoke.SOIL["diameter_min"], "m", "smallest particle diameter (uniform distribution)",
+                             _BED["diameter_min"])
+    diameter_max: float = _q(smoke.SOIL["diameter_max"], "m", "largest particle diameter", _BED["diameter_max"])
     gravity: Union[float, tuple[float, float, float], str] = Field(
-        "earth", description="'earth' (9.81 m/s^2), 'moon' (9.81/6), a magnitude in m/s^2, or a vector "
+        smoke.GRAVITY, description="'earth' (9.81 m/s^2), 'moon' (9.81/6), a magnitude in m/s^2, or a vector "
                              "[gx, gy, gz] with gz < 0; the bed is prepared under the gravity it is tested at")
-    youngs_modulus: float = _q(50e6, "Pa", "particle Young's modulus (seed 004 Table 1); at most 1.2e12 Pa "
-                                           "(diamond)", gt=0, le=1.2e12)
-    poisson_ratio: float = _q(0.3, "1", "particle Poisson's ratio", gt=-1, lt=0.5)
-    density: float = _q(3200.0, "kg/m^3", "particle density", gt=0)
-    restitution: float = _q(0.5, "1", "soil--soil coefficient of restitution", gt=0, le=1)
-    static_friction: float = _q(0.42, "1", "soil--soil Coulomb friction coefficient", ge=0)
-    rolling_friction: float = _q(0.11, "1", "soil--soil rolling friction coefficient", ge=0)
-    periodic: bool = Field(True, description="prepare the bin periodic along its length: a moving soil patch keeps "
+    youngs_modulus: float = _q(_SOIL_MATERIAL.youngs_modulus, "Pa", "particle Young's modulus (seed 004 Table 1); "
+                               "at most 1.2e12 Pa (diamond)", _MATERIAL["youngs_modulus"])
+    poisson_ratio: float = _q(_SOIL_MATERIAL.poisson_ratio, "1", "particle Poisson's ratio", _MATERIAL["poisson_ratio"])
+    density: float = _q(_SOIL_MATERIAL.density, "kg/m^3", "particle density", _MATERIAL["density"])
+    restitution: float = _q(_SOIL_PAIR.restitution, "1", "soil--soil coefficient of restitution", _PAIR["restitution"])
+    static_friction: float = _q(_SOIL_PAIR.static_friction, "1", "soil--soil Coulomb friction coefficient",
+                                _PAIR["static_friction"])
+    rolling_friction: float = _q(_SOIL_PAIR.rolling_friction, "1", "soil--soil rolling friction coefficient",
+                                 _PAIR["rolling_friction"])
+    periodic: bool = Field(smoke.SOIL["periodic"], description="prepare the bin periodic along its length: a moving soil patch keeps "
                                               "fresh soil ahead of the wheel for any drive (the bin need not grow "
                                               "with test.drive_time)")
     time_step: Optional[float] = _q(None, "s", "DEM time step of the run (default: the stable Hertz/Rayleigh "
                                                 "estimate); the bed is prepared with that estimate either way",
-                                       gt=0)
-    max_settle_time: float = _q(10.0, "s", "give up preparing the bed after this much settling", gt=0)
+                                       _TEST["time_step"])
+    max_settle_time: float = _q(smoke.SOIL["max_settle_time"], "s", "give up preparing the bed after this much "
+                                "settling", _BED["max_settle_time"])
 
     @field_validator("gravity")
     @classmethod
@@ -134,80 +153,99 @@ WHEEL_PRESETS = ("lunar-rover", "exomars")
 
 class Wheel(_Section):
     preset: Literal["lunar-rover", "exomars"] = Field(
-        "lunar-rover", description="base wheel: lunar-rover (seed 004, r = 0.6 m) or exomars (seeds 000/001); "
+        smoke.WHEEL_PRESET, description="base wheel: lunar-rover (seed 004, r = 0.6 m) or exomars (seeds 000/001); "
                                    "the keys below replace its dimensions")
-    element_size: Optional[float] = _q(0.05, "m", "target element edge of the mesh (preset's own: 0.018 m "
-                                                  "lunar-rover, 0.006 m exomars)", gt=0)
-    rigid: bool = Field(False, description="use the rigid wheel with the same surface")
-    damping: float = _q(10.0, "1/s", "mass-proportional structural damping, relative to the hub", ge=0)
-    radius: Optional[float] = _q(None, "m", "outer tread radius (without grousers)", gt=0)
-    width: Optional[float] = _q(None, "m", "tread width", gt=0)
-    tread_thickness: Optional[float] = _q(None, "m", "tread sheet thickness", gt=0)
-    hub_radius: Optional[float] = _q(None, "m", "hub radius", gt=0)
-    spokes_per_row: Optional[int] = Field(None, ge=1, description="spokes in each spoke row")
-    spoke_thickness: Optional[float] = _q(None, "m", "spoke sheet thickness", gt=0)
-    spoke_bow: Optional[float] = _q(None, "1", "spoke bow as a fraction of its length", ge=0, le=0.5)
+    element_size: Optional[float] = _q(smoke.WHEEL["element_size"], "m", "target element edge of the mesh "
+                                       "(preset's own: 0.018 m lunar-rover, 0.006 m exomars)", _WHEEL["element_size"])
+    rigid: bool = Field(smoke.WHEEL["rigid"], description="use the rigid wheel with the same surface")
+    damping: float = _q(smoke.WHEEL["damping"], "1/s", "mass-proportional structural damping, relative to the hub",
+                        _TEST["damping"])
+    radius: Optional[float] = _q(None, "m", "outer tread radius (without grousers)", _WHEEL["radius"])
+    width: Optional[float] = _q(None, "m", "tread width", _WHEEL["width"])
+    tread_thickness: Optional[float] = _q(None, "m", "tread sheet thickness", _WHEEL["tread_thickness"])
+    hub_radius: Optional[float] = _q(None, "m", "hub radius", _WHEEL["hub_radius"])
+    spokes_per_row: Optional[int] = Field(None, description="spokes in each spoke row",
+                                          **_WHEEL["spokes_per_row"].limits())
+    spoke_thickness: Optional[float] = _q(None, "m", "spoke sheet thickness", _WHEEL["spoke_thickness"])
+    spoke_bow: Optional[float] = _q(None, "1", "spoke bow as a fraction of its length", _WHEEL["spoke_bow"])
     spoke_model: Optional[Literal["shell", "beam"]] = Field(None, description="spokes as shells or beams")
     spoke_rows: Optional[list[tuple[float, float, float]]] = Field(
         None, description="spoke rows as [y_min, y_max, angle]: band of the width (fractions, -0.5..0.5) "
                           "and angle of the first spoke [deg]")
-    grouser_count: Optional[int] = Field(None, ge=0, description="grousers around the tread (0: smooth)")
-    grouser_height: Optional[float] = _q(None, "m", "grouser height", ge=0)
-    grouser_thickness: Optional[float] = _q(None, "m", "grouser sheet thickness", ge=0)
-    grouser_angle: Optional[float] = _q(None, "deg", "grouser angle to the axle (chevron half-angle)")
-    hub_mass: Optional[float] = _q(None, "kg", "hub mass (with the rig's moving parts)", ge=0)
+    grouser_count: Optional[int] = Field(None, description="grousers around the tread (0: smooth)",
+                                         **_WHEEL["grouser_count"].limits())
+    grouser_height: Optional[float] = _q(None, "m", "grouser height", _WHEEL["grouser_height"])
+    grouser_thickness: Optional[float] = _q(None, "m", "grouser sheet thickness", _WHEEL["grouser_thickness"])
+    grouser_angle: Optional[float] = _q(None, "deg", "grouser angle to the axle (chevron half-angle)",
+                                        _WHEEL["grouser_angle"])
+    hub_mass: Optional[float] = _q(None, "kg", "hub mass (with the rig's moving parts)", _WHEEL["hub_mass"])
     youngs_modulus: Optional[float] = _q(None, "Pa", "wheel material Young's modulus; at most 1.2e12 Pa (diamond)",
-                                         gt=0, le=1.2e12)
-    poisson_ratio: Optional[float] = _q(None, "1", "wheel material Poisson's ratio", gt=-1, lt=0.5)
-    density: Optional[float] = _q(None, "kg/m^3", "wheel material density", gt=0)
+                                         _MATERIAL["youngs_modulus"])
+    poisson_ratio: Optional[float] = _q(None, "1", "wheel material Poisson's ratio", _MATERIAL["poisson_ratio"])
+    density: Optional[float] = _q(None, "kg/m^3", "wheel material density", _MATERIAL["density"])
 
 
 class Contact(_Section):
-    restitution: float = _q(0.5, "1", "soil--wheel coefficient of restitution (seed 004 soil--steel)", gt=0, le=1)
-    static_friction: float = _q(0.39, "1", "soil--wheel Coulomb friction coefficient", ge=0)
-    rolling_friction: float = _q(0.15, "1", "soil--wheel rolling friction coefficient", ge=0)
+    restitution: float = _q(_CONTACT.restitution, "1", "soil--wheel coefficient of restitution (seed 004 "
+                            "soil--steel)", _PAIR["restitution"])
+    static_friction: float = _q(_CONTACT.static_friction, "1", "soil--wheel Coulomb friction coefficient",
+                                _PAIR["static_friction"])
+    rolling_friction: float = _q(_CONTACT.rolling_friction, "1", "soil--wheel rolling friction coefficient",
+                                 _PAIR["rolling_friction"])
 
 
 class Test(_Section):
     __test__ = False  # not a pytest class
 
-    slip: float = _q(0.3, "1", "longitudinal slip i = 1 - v_x / (r omega) (negative: braking)", ge=-1, lt=1)
-    slip_angle: float = _q(10.0, "deg", "steering (slip) angle beta between heading and travel", gt=-90, lt=90)
-    load: float = _q(3000.0, "N", "vertical load W on the soil, wheel weight included", gt=0)
-    angular_velocity: float = _q(1.0, "rad/s", "wheel spin omega", gt=0)
-    lowering_speed: float = _q(0.3, "m/s", "speed at which the rig lowers the wheel until the soil carries W", gt=0)
-    settle_time: float = _q(0.1, "s", "rest, free vertically under W, before driving", gt=0)
-    spin_up_time: float = _q(0.05, "s", "time over which omega and the carriage speed ramp up", ge=0)
-    drive_time: float = _q(4.0, "s", "longest drive after the spin-up; the run ends sooner once it is steady "
-                                     "(stop_when_steady)", gt=0)
-    stop_when_steady: bool = Field(True, description="end the run at the first steady window of "
-                                                     "output.average_time (false: drive the whole drive_time)")
+    slip: float = _q(smoke.TEST["slip"], "1", "longitudinal slip i = 1 - v_x / (r omega) (negative: braking)",
+                     _TEST["slip"])
+    slip_angle: float = _q(smoke.TEST["slip_angle"], "deg", "steering (slip) angle beta between heading and travel",
+                           _TEST["slip_angle"])
+    load: float = _q(smoke.TEST["load"], "N", "vertical load W on the soil, wheel weight included", _TEST["load"])
+    angular_velocity: float = _q(smoke.TEST["angular_velocity"], "rad/s", "wheel spin omega",
+                                 _TEST["angular_velocity"])
+    lowering_speed: float = _q(smoke.TEST["lowering_speed"], "m/s", "speed at which the rig lowers the wheel until "
+                               "the soil carries W", _TEST["lowering_speed"])
+    settle_time: float = _q(smoke.TEST["settle_time"], "s", "rest, free vertically under W, before driving",
+                            _TEST["settle_time"])
+    spin_up_time: float = _q(smoke.TEST["spin_up_time"], "s", "time over which omega and the carriage speed ramp up",
+                             _TEST["spin_up_time"])
+    drive_time: float = _q(smoke.TEST["drive_time"], "s", "longest drive after the spin-up; the run ends sooner once "
+                           "it is steady (stop_when_steady)", _TEST["drive_time"])
+    stop_when_steady: bool = Field(smoke.TEST["stop_when_steady"], description="end the run at the first steady "
+                                   "window of output.average_time (false: drive the whole drive_time)")
     windup: Literal["controller", "none"] = Field(
-        "controller", description="'controller': after the spin-up the hub's spin follows the tread's (feedback) "
-                                  "until the wheel has wound up to the tread slip commanded, then holds omega; "
-                                  "'none': hold omega from the spin-up on")
-    windup_gain: float = _q(4.0, "1", "feedback gain of the wind-up controller", gt=0, le=50)
-    max_wind_up: float = _q(0.6, "rad", "stop the run when the tread lags the hub by more than this", gt=0, le=1.5708)
+        smoke.TEST["windup"], description="'controller': after the spin-up the hub's spin follows the tread's "
+                                          "(feedback) until the wheel has wound up to the tread slip commanded, then "
+                                          "holds omega; 'none': hold omega from the spin-up on")
+    windup_gain: float = _q(smoke.TEST["windup_gain"], "1", "feedback gain of the wind-up controller",
+                            _TEST["windup_gain"])
+    max_wind_up: float = _q(smoke.TEST["max_wind_up"], "rad", "stop the run when the tread lags the hub by more than "
+                            "this", _TEST["max_wind_up"])
     start_x: Optional[float] = _q(None, "m", "initial hub position along the bin (default: radius + 0.1 m; the "
-                                             "middle of a periodic bin)", gt=0)
+                                             "middle of a periodic bin)", _TEST["start_x"])
     axle_damping: Optional[float] = _q(None, "N s/m", "damper on the rig's vertical slide (default: wheel "
-                                                      "mass / 0.1 s)", ge=0)
+                                                      "mass / 0.1 s)", _TEST["axle_damping"])
 
 
 class Output(_Section):
-    sample_interval: float = _q(0.005, "s", "averaging interval of one time-series sample", gt=0)
-    average_time: float = _q(1.0, "s", "shortest averaging window once steady (whole pitches of the tread)", gt=0)
-    steady_tolerance: float = _q(0.1, "1", "largest drift over the averaging window, relative to the mean (or a "
-                                           "floor: 5 % of W for forces)", gt=0, le=1)
-    slip_tolerance: float = _q(0.03, "1", "largest difference between tread slip and commanded slip when steady",
-                               gt=0, le=0.5)
-    steady_checks: int = Field(2, ge=1, le=10, description="consecutive checks, one period of the tread apart, "
-                               "that must find the run steady before it stops and is reported steady")
-    frame_interval: float = _q(0.05, "s", "simulated time between frames (particles, wheel nodes) kept in the "
-                                          "result; 0: the last frame only", ge=0)
-    checkpoint_interval: float = _q(0.25, "s", "simulated time between checkpoints a killed run resumes from "
-                                               "(--resume); 0: none", ge=0)
-    render: bool = Field(True, description="render the last state to final.png")
+    sample_interval: float = _q(smoke.OUTPUT["sample_interval"], "s", "averaging interval of one time-series sample",
+                                _TEST["sample_interval"])
+    average_time: float = _q(smoke.OUTPUT["average_time"], "s", "shortest averaging window once steady (whole "
+                             "pitches of the tread)", _TEST["average_time"])
+    steady_tolerance: float = _q(smoke.OUTPUT["steady_tolerance"], "1", "largest drift over the averaging window, "
+                                 "relative to the mean (or a floor: 5 % of W for forces)", _TEST["steady_tolerance"])
+    slip_tolerance: float = _q(smoke.OUTPUT["slip_tolerance"], "1", "largest difference between tread slip and "
+                               "commanded slip when steady", _TEST["slip_tolerance"])
+    steady_checks: int = Field(smoke.OUTPUT["steady_checks"], description="consecutive checks, one period of the "
+                               "tread apart, that must find the run steady before it stops and is reported steady",
+                               **_TEST["steady_checks"].limits())
+    # what a run keeps (cases.run's own: no solver spec carries these two)
+    frame_interval: float = _q(smoke.OUTPUT["frame_interval"], "s", "simulated time between frames (particles, "
+                               "wheel nodes) kept in the result; 0: the last frame only", non_negative())
+    checkpoint_interval: float = _q(smoke.OUTPUT["checkpoint_interval"], "s", "simulated time between checkpoints a "
+                                    "killed run resumes from (--resume); 0: none", non_negative())
+    render: bool = Field(smoke.OUTPUT["render"], description="render the last state to final.png")
 
 
 SECTIONS: dict[str, type[_Section]] = {
@@ -237,63 +275,6 @@ class CaseFile(BaseModel):
         data["case"].pop("name")
         data["case"].pop("description")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
-
-    # ---------------------------------------------------------------- the solver's objects
-    def bed_spec(self):
-        """The :class:`~wheelsoil.granular.BedSpec` of the soil section."""
-        from wheelsoil.granular.bed import BedSpec
-        from wheelsoil.granular.materials import PairProperties
-        from wheelsoil.material import Material
-
-        s = self.soil
-        return BedSpec(
-            length=s.length, width=s.width, depth=s.depth, diameter_min=s.diameter_min,
-            diameter_max=s.diameter_max, gravity=s.gravity_vector,
-            material=Material("lunar soil simulant", s.youngs_modulus, s.poisson_ratio, s.density),
-            pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
-            seed=self.case.seed, max_settle_time=s.max_settle_time, periodic=s.periodic,
-        )
-
-    def wheel_geometry(self):
-        """The :class:`~wheelsoil.flexwheel.geometry.WheelGeometry` of the wheel section."""
-        from dataclasses import replace
-
-        from wheelsoil.flexwheel.geometry import SpokeRow, preset
-        from wheelsoil.material import Material
-
-        w = self.wheel
-        base = preset(w.preset)
-        changes = {k: getattr(w, k) for k in (
-            "element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
-            "spoke_bow", "spoke_model", "grouser_count", "grouser_height", "grouser_thickness", "grouser_angle",
-            "hub_mass") if getattr(w, k) is not None}
-        if w.spoke_rows is not None:
-            changes["spoke_rows"] = tuple(SpokeRow(*row) for row in w.spoke_rows)
-        if any(v is not None for v in (w.youngs_modulus, w.poisson_ratio, w.density)):
-            m = base.material
-            changes["material"] = Material(
-                f"{base.name} material (case)",
-                youngs_modulus=w.youngs_modulus if w.youngs_modulus is not None else m.youngs_modulus,
-                poisson_ratio=w.poisson_ratio if w.poisson_ratio is not None else m.poisson_ratio,
-                density=w.density if w.density is not None else m.density)
-        return replace(base, **changes)
-
-    def testbed_spec(self):
-        """The :class:`~wheelsoil.coupling.testbed.TestbedSpec` of the test, contact and output sections."""
-        from wheelsoil.coupling.testbed import TestbedSpec
-        from wheelsoil.granular.materials import PairProperties
-
-        t, o, c = self.test, self.output, self.contact
-        return TestbedSpec(
-            slip=t.slip, slip_angle=t.slip_angle, load=t.load, angular_velocity=t.angular_velocity,
-            lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
-            drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
-            windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
-            sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
-            steady_checks=o.steady_checks, start_x=t.start_x, time_step=self.soil.time_step, rigid=self.wheel.rigid,
-            damping=self.wheel.damping, axle_damping=t.axle_damping,
-            pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
-        )
 
 
 # -------------------------------------------------------------------- reading
@@ -412,9 +393,7 @@ def validate_case(data: dict, source: str, *, default_name: str | None = None) -
                                      f"({'the last frame only' if key == 'frame_interval' else 'none'}) or at least "
                                      f"{o.sample_interval:g} s"])
     try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, the drive, ...)
-        from wheelsoil.coupling.testbed import check_fits
-
-        check_fits(case.bed_spec(), case.wheel_geometry(), case.testbed_spec())
+        check_fits(*build.specs(case))
     except WheelsoilInputError as exc:
         raise CaseError(source, [str(exc)]) from None
     return case

@@ -47,6 +47,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output
 
+from . import build
 from .run import RESULT_NAME
 from .schema import (CaseError, CaseFile, apply_overrides, case_to_toml, load_case, parse_toml, read_toml_text,
                      validate_case)
@@ -305,7 +306,7 @@ def summary_table(sweep: Sweep):
         t = c.case.test
         row = {"case": c.name, "case_hash": c.folder.name}
         row.update({k: (_label(v) if isinstance(v, (list, tuple)) else v) for k, v in c.values.items()})
-        wheel = c.case.wheel_geometry()
+        wheel = build.wheel_geometry(c.case)
         row.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "load_set": t.load,
                     "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
                     "wheel_radius": wheel.radius, "wheel_width": wheel.width, "grouser_count": wheel.grouser_count,

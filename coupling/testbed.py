@@ -52,6 +52,7 @@ import math
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -60,8 +61,10 @@ from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, check_
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed, BedSpec, check_memory, machine_memory
-from wheelsoil.granular.materials import SOIL_STEEL, PairProperties, effective_modulus
+from wheelsoil.granular.materials import PairProperties, effective_modulus
 from wheelsoil.granular.timestep import estimate_time_step
+from wheelsoil.parameters import smoke
+from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, slip_angle_deg
@@ -151,67 +154,71 @@ class TestbedSpec:
 
     __test__ = False  # not a pytest class
 
-    slip: float = 0.2
-    slip_angle: float = 0.0
-    load: float = 3000.0
-    angular_velocity: float = 1.0
-    lowering_speed: float = 0.3
-    settle_time: float = 0.1
-    spin_up_time: float = 0.05
-    drive_time: float = 4.0
-    stop_when_steady: bool = True
-    average_time: float = 1.0
-    windup: str = "controller"
-    windup_gain: float = 4.0
-    windup_filter: float = 0.04
-    max_wind_up: float = 0.6
-    sample_interval: float = 0.005
-    steady_tolerance: float = 0.1
-    slip_tolerance: float = 0.03
-    steady_checks: int = 2
+    slip: float = smoke.TEST["slip"]
+    slip_angle: float = smoke.TEST["slip_angle"]
+    load: float = smoke.TEST["load"]
+    angular_velocity: float = smoke.TEST["angular_velocity"]
+    lowering_speed: float = smoke.TEST["lowering_speed"]
+    settle_time: float = smoke.TEST["settle_time"]
+    spin_up_time: float = smoke.TEST["spin_up_time"]
+    drive_time: float = smoke.TEST["drive_time"]
+    stop_when_steady: bool = smoke.TEST["stop_when_steady"]
+    average_time: float = smoke.OUTPUT["average_time"]
+    windup: str = smoke.TEST["windup"]
+    windup_gain: float = smoke.TEST["windup_gain"]
+    windup_filter: float = smoke.TEST["windup_filter"]
+    max_wind_up: float = smoke.TEST["max_wind_up"]
+    sample_interval: float = smoke.OUTPUT["sample_interval"]
+    steady_tolerance: float = smoke.OUTPUT["steady_tolerance"]
+    slip_tolerance: float = smoke.OUTPUT["slip_tolerance"]
+    steady_checks: int = smoke.OUTPUT["steady_checks"]
     start_x: float | None = None
-    rigid: bool = False
-    damping: float = 10.0
+    rigid: bool = smoke.WHEEL["rigid"]
+    damping: float = smoke.WHEEL["damping"]
     axle_damping: float | None = None
     patch_shift: float | None = None
     time_step: float | None = None
-    pair: PairProperties = field(default_factory=lambda: SOIL_STEEL)
+    pair: PairProperties = smoke.CONTACT
+
+    #: Allowed range of every scalar input (None: "use the default" where a default is computed). The case
+    #: schema's [test], [output] and wheel.damping fields take their bounds from here.
+    RANGES: ClassVar[dict[str, Range]] = {
+        "slip": Range(-1.0, 1.0, hi_open=True),
+        "slip_angle": Range(-90.0, 90.0, lo_open=True, hi_open=True),
+        "load": positive(),
+        "angular_velocity": positive(),
+        "lowering_speed": positive(),
+        "settle_time": positive(),
+        "spin_up_time": non_negative(),
+        "drive_time": positive(),
+        "average_time": positive(),
+        "windup_gain": positive(hi=50.0),
+        "windup_filter": positive(),
+        "max_wind_up": positive(hi=math.pi / 2),
+        "sample_interval": positive(),
+        "steady_tolerance": positive(hi=1.0),
+        "slip_tolerance": positive(hi=0.5),
+        "steady_checks": Range(1, 10, integer=True),
+        "start_x": positive(),
+        "damping": non_negative(),
+        "axle_damping": non_negative(),
+        "patch_shift": positive(),
+        "time_step": positive(),
+    }
+    UNITS: ClassVar[dict[str, str]] = {
+        "slip_angle": "deg", "load": "N", "angular_velocity": "rad/s", "lowering_speed": "m/s", "settle_time": "s",
+        "spin_up_time": "s", "drive_time": "s", "average_time": "s", "windup_filter": "s", "max_wind_up": "rad",
+        "sample_interval": "s", "start_x": "m", "damping": "1/s", "axle_damping": "N s/m", "patch_shift": "m",
+        "time_step": "s",
+    }
 
     def __post_init__(self) -> None:
-        fin = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)  # noqa: E731
-        _check("slip", self.slip, fin(self.slip) and -1.0 <= self.slip < 1.0, "-1 <= slip < 1")
-        _check("slip_angle", self.slip_angle, fin(self.slip_angle) and -90.0 < self.slip_angle < 90.0,
-               "-90 < slip_angle < 90 deg")
-        _check("load", self.load, fin(self.load) and self.load > 0.0, "load > 0 N")
-        _check("angular_velocity", self.angular_velocity, fin(self.angular_velocity) and self.angular_velocity > 0.0,
-               "angular_velocity > 0 rad/s")
-        for key in ("lowering_speed", "settle_time", "drive_time", "sample_interval", "average_time",
-                    "steady_tolerance", "slip_tolerance", "windup_gain", "windup_filter", "max_wind_up"):
-            v = getattr(self, key)
-            _check(key, v, fin(v) and v > 0.0, f"{key} > 0")
-        for key in ("spin_up_time", "damping"):
-            v = getattr(self, key)
-            _check(key, v, fin(v) and v >= 0.0, f"{key} >= 0")
-        _check("steady_checks", self.steady_checks,
-               isinstance(self.steady_checks, int) and not isinstance(self.steady_checks, bool)
-               and 1 <= self.steady_checks <= 10, "an integer 1 <= steady_checks <= 10")
+        check_ranges(self, self.RANGES, "testbed", self.UNITS)
         _check("windup", self.windup, self.windup in ("controller", "none"), "'controller' or 'none'")
-        _check("max_wind_up", self.max_wind_up, self.max_wind_up <= math.pi / 2, "max_wind_up <= pi/2 rad")
         _check("average_time", self.average_time, self.average_time < self.drive_time,
                f"average_time < drive_time = {self.drive_time} s")
         _check("sample_interval", self.sample_interval, self.sample_interval <= 0.25 * self.average_time,
                f"sample_interval <= average_time / 4 = {0.25 * self.average_time:g} s")
-        if self.axle_damping is not None:
-            _check("axle_damping", self.axle_damping, fin(self.axle_damping) and self.axle_damping >= 0.0,
-                   "axle_damping >= 0 N s/m, or None for wheel mass / 0.1 s")
-        if self.start_x is not None:
-            _check("start_x", self.start_x, fin(self.start_x) and self.start_x > 0.0, "start_x > 0 m")
-        if self.patch_shift is not None:
-            _check("patch_shift", self.patch_shift, fin(self.patch_shift) and self.patch_shift > 0.0,
-                   "patch_shift > 0 m, or None for a fifth of the wheel radius")
-        if self.time_step is not None:
-            _check("time_step", self.time_step, fin(self.time_step) and self.time_step > 0.0,
-                   "time_step > 0 s, or None for the bed's stable estimate")
         if not isinstance(self.pair, PairProperties):
             raise WheelsoilInputError(f"testbed pair must be a PairProperties, got {type(self.pair).__name__}")
 

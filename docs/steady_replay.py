@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.cases import build
 from wheelsoil.cases.schema import load_case
 from wheelsoil.coupling.steady import confirm_steady
 from wheelsoil.coupling.testbed import batches_per_period, detect_from_rows, statistics_pitch
@@ -42,7 +43,7 @@ def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = 
     check [s] and how many checks were made. ``whole_periods=False``: every batch taken for a whole period of
     the wheel (the detector before it knew the period of a wheel whose grousers and spokes differ)."""
     case = load_case(run_dir / "case.toml")
-    spec, bed, wheel = case.testbed_spec(), case.bed_spec(), case.wheel_geometry()
+    spec, bed, wheel = build.testbed_spec(case), build.bed_spec(case), build.wheel_geometry(case)
     run = json.loads((run_dir / "summary.json").read_text())["run"]
     rows = read_series(run_dir / "series.csv")
     t = rows["t"]

@@ -17,13 +17,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.parameters import exomars, seed004
+from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
 from .beam import rectangular_section
-from .material import SEED004_WHEEL, SPRING_STEEL, Material
+from .material import SEED004_WHEEL, Material
 from .mesh import StructureMesh
 from .shapes import grid_triangles
 
@@ -63,14 +66,21 @@ class WheelGeometry:
     nominal_load: float = 0.0
     name: str = "wheel"
 
-    def __post_init__(self) -> None:
-        def positive(key):
-            v = getattr(self, key)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise WheelsoilInputError(f"wheel {self.name!r}: {key}={v!r} must be a finite number > 0")
+    RANGES: ClassVar[dict[str, Range]] = {
+        "radius": positive(), "width": positive(), "tread_thickness": positive(), "hub_radius": positive(),
+        "spokes_per_row": Range(lo=1, integer=True), "spoke_thickness": positive(), "spoke_bow": Range(0.0, 0.5),
+        "grouser_count": Range(lo=0, integer=True), "grouser_height": non_negative(),
+        "grouser_thickness": non_negative(), "grouser_angle": Range(-89.0, 89.0), "element_size": positive(),
+        "hub_mass": non_negative(), "nominal_load": non_negative(),
+    }
+    UNITS: ClassVar[dict[str, str]] = {
+        "radius": "m", "width": "m", "tread_thickness": "m", "hub_radius": "m", "spoke_thickness": "m",
+        "grouser_height": "m", "grouser_thickness": "m", "grouser_angle": "deg", "element_size": "m",
+        "hub_mass": "kg", "nominal_load": "N",
+    }
 
-        for key in ("radius", "width", "tread_thickness", "hub_radius", "spoke_thickness", "element_size"):
-            positive(key)
+    def __post_init__(self) -> None:
+        check_ranges(self, self.RANGES, f"wheel {self.name!r}:", self.UNITS)
         if self.hub_radius >= self.radius - self.tread_thickness:
             raise WheelsoilInputError(
                 f"wheel {self.name!r}: hub_radius={self.hub_radius!r} m must be smaller than the tread's inner "
@@ -80,10 +90,6 @@ class WheelGeometry:
             raise WheelsoilInputError(
                 f"wheel {self.name!r}: tread_thickness={self.tread_thickness!r} m is not thin (must be < radius/4)"
             )
-        if int(self.spokes_per_row) != self.spokes_per_row or self.spokes_per_row < 1:
-            raise WheelsoilInputError(f"wheel {self.name!r}: spokes_per_row={self.spokes_per_row!r} must be an integer >= 1")
-        if not (0.0 <= self.spoke_bow <= 0.5):
-            raise WheelsoilInputError(f"wheel {self.name!r}: spoke_bow={self.spoke_bow!r} must lie in [0, 0.5]")
         if self.spoke_model not in ("shell", "beam"):
             raise WheelsoilInputError(f"wheel {self.name!r}: spoke_model={self.spoke_model!r}; choose 'shell' or 'beam'")
         if not self.spoke_rows:
@@ -94,11 +100,10 @@ class WheelGeometry:
                     f"wheel {self.name!r}: spoke_rows[{k}] spans y in [{row.y_min}, {row.y_max}] (fractions of the "
                     "width); need -0.5 <= y_min < y_max <= 0.5"
                 )
-        if int(self.grouser_count) != self.grouser_count or self.grouser_count < 0:
-            raise WheelsoilInputError(f"wheel {self.name!r}: grouser_count={self.grouser_count!r} must be an integer >= 0")
         if self.grouser_count:
-            positive("grouser_height")
-            positive("grouser_thickness")
+            for key in ("grouser_height", "grouser_thickness"):
+                positive().check(f"wheel {self.name!r}: with grouser_count = {self.grouser_count},", key,
+                                 getattr(self, key), "m")
         if self.element_size > 0.25 * self.width:
             raise WheelsoilInputError(
                 f"wheel {self.name!r}: element_size={self.element_size!r} m is too coarse for width {self.width} m "
@@ -275,53 +280,20 @@ def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray
     return mesh, np.unique(np.asarray(hub_nodes, np.int64))
 
 
-#: The flexible metal wheel of the staffed lunar rover of seed 004 (r = 0.6 m, b = 0.5 m, Table 2
-#: material E = 800 MPa, nu = 0.288, rho = 7850 kg/m^3). The paper gives no drawing dimensions; the
-#: tread, spoke and grouser sizes are ours (two side rows of 12 bowed spokes). ``element_size``
-#: 0.018 m gives a mesh of the paper's size (about 30,000 elements); coarser sizes are for quick runs.
-LUNAR_ROVER = WheelGeometry(
-    name="lunar-rover",
-    radius=0.6,
-    width=0.5,
-    tread_thickness=0.005,
-    hub_radius=0.15,
-    spokes_per_row=12,
-    spoke_thickness=0.010,
-    spoke_rows=(SpokeRow(-0.5, -0.3, 0.0), SpokeRow(0.3, 0.5, 0.0)),
-    spoke_bow=0.1,
-    grouser_count=24,
-    grouser_height=0.02,
-    grouser_thickness=0.004,
-    grouser_angle=7.5,
-    material=SEED004_WHEEL,
-    element_size=0.018,
-    hub_mass=20.0,
-    nominal_load=3000.0,
-)
+def from_parameters(values: dict) -> WheelGeometry:
+    """A :class:`WheelGeometry` from a parameter set's keyword dictionary (spoke rows as (y_min, y_max, angle))."""
+    values = dict(values)
+    values["spoke_rows"] = tuple(SpokeRow(*row) for row in values["spoke_rows"])
+    return WheelGeometry(**values)
 
-#: ExoMars-like flexible wheel (seed 000: r = 142.5 mm, b = 120 mm, 12 grousers of 12.5 mm; three
-#: flexible loops on each side plus three inner loops rotated by 60 deg = six virtual spokes, hence six
-#: stiffness peaks per turn). Sheet thicknesses are ours, chosen so that the radial point-load
-#: stiffness comes out near the 13.2 kN/m quoted for the ExoMars wheel in seed 001.
-EXOMARS = WheelGeometry(
-    name="exomars",
-    radius=0.1425,
-    width=0.12,
-    tread_thickness=0.0008,
-    hub_radius=0.045,
-    spokes_per_row=3,
-    spoke_thickness=0.0005,
-    spoke_rows=(SpokeRow(-0.5, -0.25, 0.0), SpokeRow(0.25, 0.5, 0.0), SpokeRow(-0.125, 0.125, 60.0)),
-    spoke_bow=0.3,
-    grouser_count=12,
-    grouser_height=0.0125,
-    grouser_thickness=0.0010,
-    grouser_angle=15.0,
-    material=SPRING_STEEL,
-    element_size=0.006,
-    hub_mass=1.0,
-    nominal_load=172.0,
-)
+
+#: The flexible metal wheel of the staffed lunar rover of seed 004 (:data:`wheelsoil.parameters.seed004.LUNAR_ROVER_WHEEL`:
+#: r = 0.6 m, b = 0.5 m, Table 2 material; tread, spoke and grouser sizes ours). ``element_size`` 0.018 m gives a
+#: mesh of the paper's size (about 30,000 elements); coarser sizes are for quick runs.
+LUNAR_ROVER = from_parameters(seed004.LUNAR_ROVER_WHEEL)
+
+#: ExoMars-like flexible wheel of seeds 000/001 (:data:`wheelsoil.parameters.exomars.EXOMARS_WHEEL`).
+EXOMARS = from_parameters(exomars.EXOMARS_WHEEL)
 
 PRESETS = {g.name: g for g in (LUNAR_ROVER, EXOMARS)}
 

@@ -24,15 +24,19 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import h5py
 import numpy as np
 
+from wheelsoil.gravity import GRAVITY_PRESETS
+from wheelsoil.parameters import smoke
 from wheelsoil.provenance import atomic_output, provenance
+from wheelsoil.ranges import Range, check_ranges, positive
 
 from . import runtime
 from .errors import SimulationUnstableError, WheelsoilInputError
-from .materials import LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL, Material, PairProperties
+from .materials import SOIL_STEEL, STEEL, Material, PairProperties
 from .ordering import column_order
 from .scene import Scene
 
@@ -69,28 +73,37 @@ class BedSpec:
         patch that a moving-patch testbed can shift without end (``wheelsoil.coupling.patch``).
     """
 
-    length: float = 0.5
-    width: float = 0.25
-    depth: float = 0.1
-    diameter_min: float = 0.016
-    diameter_max: float = 0.024
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    material: Material = LUNAR_SOIL_SIMULANT
-    pair: PairProperties = SOIL_SOIL
+    length: float = smoke.SOIL["length"]
+    width: float = smoke.SOIL["width"]
+    depth: float = smoke.SOIL["depth"]
+    diameter_min: float = smoke.SOIL["diameter_min"]
+    diameter_max: float = smoke.SOIL["diameter_max"]
+    gravity: tuple[float, float, float] = (0.0, 0.0, -GRAVITY_PRESETS[smoke.GRAVITY])
+    material: Material = smoke.SOIL_MATERIAL
+    pair: PairProperties = smoke.SOIL_SOIL
     wall_material: Material | None = STEEL
     wall_pair: PairProperties = SOIL_STEEL
-    seed: int = 0
+    seed: int = smoke.SEED
     kinetic_energy_threshold: float | None = None
-    max_settle_time: float = 10.0
+    max_settle_time: float = smoke.SOIL["max_settle_time"]
     overfill: float = 1.15
     time_step: float | None = None
-    periodic: bool = False
+    periodic: bool = smoke.SOIL["periodic"]
+
+    #: Allowed range of every scalar input (None: the computed default). The case schema's [soil] fields take
+    #: their bounds from here.
+    RANGES: ClassVar[dict[str, Range]] = {
+        "length": positive(), "width": positive(), "depth": positive(), "diameter_min": positive(),
+        "diameter_max": positive(), "max_settle_time": positive(), "seed": Range(lo=0, integer=True),
+        "overfill": Range(1.0, 3.0), "kinetic_energy_threshold": positive(), "time_step": positive(),
+    }
+    UNITS: ClassVar[dict[str, str]] = {
+        "length": "m", "width": "m", "depth": "m", "diameter_min": "m", "diameter_max": "m", "max_settle_time": "s",
+        "kinetic_energy_threshold": "J", "time_step": "s",
+    }
 
     def __post_init__(self) -> None:
-        for name in ("length", "width", "depth", "diameter_min", "diameter_max", "max_settle_time"):
-            value = float(getattr(self, name))
-            if not (math.isfinite(value) and value > 0):
-                raise WheelsoilInputError(f"bed {name} = {value!r} is invalid: it must be a finite number > 0")
+        check_ranges(self, self.RANGES, "bed", self.UNITS)
         if self.diameter_max < self.diameter_min:
             raise WheelsoilInputError(
                 f"bed diameter_max = {self.diameter_max!r} m is smaller than diameter_min = {self.diameter_min!r} m"
@@ -111,14 +124,6 @@ class BedSpec:
             raise WheelsoilInputError(
                 f"bed depth = {self.depth} m must be at least two of the largest particles ({2 * self.diameter_max} m)"
             )
-        if not (1.0 <= self.overfill <= 3.0):
-            raise WheelsoilInputError(f"bed overfill = {self.overfill!r} must lie in [1, 3]")
-        if self.kinetic_energy_threshold is not None and not (self.kinetic_energy_threshold > 0):
-            raise WheelsoilInputError(
-                f"bed kinetic_energy_threshold = {self.kinetic_energy_threshold!r} J must be > 0"
-            )
-        if self.time_step is not None and not (self.time_step > 0):
-            raise WheelsoilInputError(f"bed time_step = {self.time_step!r} s must be > 0")
         object.__setattr__(self, "periodic", bool(self.periodic))
 
     # ---------------------------------------------------------------- derived quantities

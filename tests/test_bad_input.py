@@ -63,7 +63,7 @@ def test_render_and_report_places_are_checked_before_work(tmp_path, a_file, caps
     """The report folder is checked before the data are even read (the data path need not exist)."""
     from wheelsoil.granular import BedSpec, prepare_bed
 
-    bed = prepare_bed(BedSpec(length=0.2, width=0.1, depth=0.03, diameter_min=0.01, diameter_max=0.012),
+    bed = prepare_bed(BedSpec(length=0.2, width=0.1, depth=0.03, diameter_min=0.01, diameter_max=0.012, periodic=False),
                       cache_dir=tmp_path / "cache")
     path = bed.save(tmp_path / "bed.h5")
     _refused(["render", str(path), "--out", str(tmp_path)], capsys, "is a folder; give a file name")

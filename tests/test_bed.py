@@ -7,7 +7,7 @@ import pytest
 from wheelsoil.granular import BedSpec, WheelsoilInputError, column_order, load_bed, prepare_bed
 from wheelsoil.granular.bed import bed_cache_path, measure_packing_fraction
 
-TINY = dict(length=0.16, width=0.1, depth=0.06)
+TINY = dict(length=0.16, width=0.1, depth=0.06, diameter_min=0.016, diameter_max=0.024, periodic=False)
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +94,7 @@ def test_packing_fraction_of_a_simple_cubic_lattice_is_pi_over_6(height_cells):
     """Touching spheres on a simple cubic lattice fill pi/6 of space. The core region is a whole
     number of lattice cells, as short as one cell, and the estimate must be exact for each."""
     a = 0.02  # lattice spacing = diameter [m]
-    spec = BedSpec(length=12 * a, width=9 * a, depth=0.1, diameter_min=a, diameter_max=a)
+    spec = BedSpec(length=12 * a, width=9 * a, depth=0.1, diameter_min=a, diameter_max=a, periodic=False)
     # region [a, L - a] x [a, W - a] x [a, surface - a]: 10 x 7 x height_cells lattice cells
     surface = (2 + height_cells) * a
     # centres offset by 0.3 a from the region's faces so none lies on a boundary
@@ -142,7 +142,7 @@ def test_a_bed_past_the_machine_memory_is_refused_before_any_work_naming_the_key
 
     from wheelsoil.granular.bed import BYTES_PER_PARTICLE, check_memory, fill_particles
 
-    spec = BedSpec(length=2.0, width=0.9, depth=0.2, diameter_min=0.001, diameter_max=0.0015)
+    spec = BedSpec(length=2.0, width=0.9, depth=0.2, diameter_min=0.001, diameter_max=0.0015, periodic=False)
     t0 = time.perf_counter()
     with pytest.raises(WheelsoilInputError) as info:
         check_memory(spec, available=24 * 2**30)
@@ -151,5 +151,5 @@ def test_a_bed_past_the_machine_memory_is_refused_before_any_work_naming_the_key
     assert "soil.diameter_min" in text and "soil.length" in text and "GiB" in text
     with pytest.raises(WheelsoilInputError):
         prepare_bed(spec, use_cache=False)  # the same check, before the lattice is built
-    small = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015)
+    small = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015, periodic=False)
     assert check_memory(small, available=24 * 2**30) == fill_particles(small) * BYTES_PER_PARTICLE

@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from wheelsoil.cases import build
 from wheelsoil.cases import convergence as cv
 from wheelsoil.cases.schema import load_case
 from wheelsoil.errors import WheelsoilInputError
@@ -37,7 +38,7 @@ def test_levels_change_only_their_keys(mini, tmp_path):
     assert study.levels["time_step"][1].case is None
     again = cv.make_study(mini, tmp_path, {"time_step": (1, 0.5)}, reference_time_step=2e-5)
     assert again.levels["time_step"][1].case.soil.time_step == pytest.approx(1e-5)
-    assert again.levels["time_step"][1].case.bed_spec() == again.reference.case.bed_spec()  # the same bed
+    assert build.bed_spec(again.levels["time_step"][1].case) == build.bed_spec(again.reference.case)  # the same bed
 
 
 @pytest.mark.parametrize("levels, message", [
@@ -109,7 +110,7 @@ def test_plan_estimates_particles_and_soil_cost(mini, tmp_path):
     particles x steps (the stable step is proportional to the particle size): x 0.8 in size is 1/0.8^4."""
     study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8), "width": (1, 2)}, reference_time_step=2e-5)
     rows = {(r["factor"], r["scale"]): r for r in cv.plan(study)}
-    spec = mini.bed_spec()
+    spec = build.bed_spec(mini)
     assert rows["particle_size", 1.0]["particles"] == round(0.6 * 0.6 * 0.25 * 0.05 / spec.mean_particle_volume)
     assert rows["particle_size", 0.8]["relative_soil_cost"] == pytest.approx(0.8**-4, rel=1e-3)  # whole particles
     assert rows["width", 2.0]["relative_soil_cost"] == pytest.approx(2.0)

@@ -4,6 +4,7 @@ import math
 
 import pytest
 
+from wheelsoil.cases import build
 from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
 from wheelsoil.cases.schema import (
     CaseError,
@@ -70,7 +71,7 @@ def test_wrong_types_and_gravity_forms(tmp_path):
         load_case(write(tmp_path, "[soil]\ngravity = [0, 0, 9.81]\n"))
     moon = load_case(write(tmp_path, '[soil]\ngravity = "moon"\n'))
     assert moon.soil.gravity_vector == (0.0, 0.0, -9.81 / 6.0)
-    assert load_case(write(tmp_path, "[soil]\ngravity = 3.71\n")).bed_spec().gravity == (0.0, 0.0, -3.71)
+    assert build.bed_spec(load_case(write(tmp_path, "[soil]\ngravity = 3.71\n"))).gravity == (0.0, 0.0, -3.71)
 
 
 def test_cross_checks_of_the_solver_name_the_problem(tmp_path):
@@ -118,7 +119,7 @@ def test_every_preset_round_trips_through_its_resolved_toml():
         assert case_from_toml(text, name) == case, name
         assert case.name == name
         # the solver's objects build from every preset
-        case.bed_spec(), case.wheel_geometry(), case.testbed_spec()
+        build.bed_spec(case), build.wheel_geometry(case), build.testbed_spec(case)
 
 
 def test_case_hash_ignores_the_name_and_follows_the_physics():
@@ -130,17 +131,17 @@ def test_case_hash_ignores_the_name_and_follows_the_physics():
 
 def test_presets_hold_the_seed004_settings():
     full = load_case("seed004-1g-steer")
-    bed = full.bed_spec()
+    bed = build.bed_spec(full)
     assert (bed.length, bed.width, bed.depth, bed.diameter_min, bed.diameter_max) == (3.5, 1.0, 0.4, 0.016, 0.024)
     assert bed.material.youngs_modulus == 50e6 and bed.material.density == 3200.0  # seed 004 Table 1
     assert bed.pair.static_friction == 0.42 and bed.pair.rolling_friction == 0.11
-    spec = full.testbed_spec()
+    spec = build.testbed_spec(full)
     assert spec.pair.static_friction == 0.39 and spec.pair.rolling_friction == 0.15
-    wheel = full.wheel_geometry()
+    wheel = build.wheel_geometry(full)
     assert (wheel.radius, wheel.width) == (0.6, 0.5)
     assert wheel.radius * spec.angular_velocity == pytest.approx(0.6)  # r omega = 0.6 m/s
     moon = load_case("seed004-moon-steer")
-    assert moon.bed_spec().gravity[2] == pytest.approx(-9.81 / 6) and moon.test.load == 500.0
+    assert build.bed_spec(moon).gravity[2] == pytest.approx(-9.81 / 6) and moon.test.load == 500.0
 
 
 def test_validate_case_refuses_a_non_table():

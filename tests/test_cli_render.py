@@ -26,7 +26,8 @@ def test_render_is_non_blank_and_sized(tmp_path):
 def test_cli_prepare_bed_and_render(tmp_path, monkeypatch):
     monkeypatch.setenv("WHEELSOIL_CACHE", str(tmp_path / "cache"))
     bed = tmp_path / "out" / "bed.h5"
-    rc = main(["prepare-bed", "--length", "0.16", "--width", "0.1", "--depth", "0.06", "--out", str(bed)])
+    rc = main(["prepare-bed", "--length", "0.16", "--width", "0.1", "--depth", "0.06", "--dmin", "0.016", "--dmax", "0.024",
+               "--walled", "--out", str(bed)])
     assert rc == EXIT_OK
     assert bed.stat().st_size > 0
     assert main(["render", str(bed), "--size", "320", "240"]) == EXIT_OK

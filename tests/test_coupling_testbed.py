@@ -18,7 +18,7 @@ MINI_WHEEL = WheelGeometry(
     spoke_thickness=0.003, spoke_bow=0.1, grouser_count=8, grouser_height=0.008, grouser_thickness=0.002,
     material=SEED004_WHEEL, element_size=0.025, hub_mass=1.0,
 )
-MINI_BED = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015)
+MINI_BED = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015, periodic=False)
 MINI_RUN = TestbedSpec(slip=0.3, slip_angle=10.0, load=80.0, angular_velocity=2.0, settle_time=0.05,
                        drive_time=0.3, average_time=0.1, stop_when_steady=False)
 

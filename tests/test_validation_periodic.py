@@ -4,6 +4,7 @@ laws (grouser passing, spoke stiffness, seed 002's slip-dependent density wave, 
 import numpy as np
 import pytest
 
+from wheelsoil.cases import build
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.validation.periodic import SIGNIFICANCE, Run, dominant_component, explain_frequencies
 
@@ -111,6 +112,7 @@ class _FakeResult:
 
     def __init__(self, case, t, y, t_spin_up):
         self.case, self.path = case, f"{case.name}.h5"
+        self.wheel = build.wheel_geometry(case)
         self.info = {"t_spin_up": t_spin_up}
         self.series = {"t": t, "torque": y}
 
@@ -124,7 +126,7 @@ def test_runs_from_results_take_the_drive_and_name_grouser_passing_in_red_noise(
     for omega in (1.0, 2.0, 3.0):
         for slip in (0.2, 0.5):
             case = load_case("smoke-1g-steer", [f"test.angular_velocity={omega}", f"test.slip={slip}"])
-            grousers, _ = wheel_counts(case.wheel_geometry())
+            grousers, _ = wheel_counts(build.wheel_geometry(case))
             t = np.arange(0.005, 3.0, 0.005)
             drive = 0.5  # the lowering and settling before it ring at another frequency, which must be cut
             y = 400.0 + 10.0 * _ar1(rng, t.size, 0.9)

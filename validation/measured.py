@@ -19,6 +19,7 @@ import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
+from wheelsoil.parameters import cmu_k10
 
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
@@ -149,10 +150,6 @@ class Measurements:
             notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes))
 
 
-#: CMU K10-mini wheel (robomechanics/3d-terramechanics parameter files, see the dataset README).
-CMU_WHEEL = {"radius": 0.058, "width": 0.05, "grouser_height": {"grouser": 0.005, "smooth": 0.0}}
-
-
 def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
     """The CMU 3D-terramechanics trials (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv``).
 
@@ -178,8 +175,8 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
     data = Measurements(
         name="cmu_3d_terramechanics",
         slip=cols("slip"), slip_angle=cols("steering_angle"), load=cols("vertical_load"),
-        gravity=np.full(n, EARTH_GRAVITY), radius=np.full(n, CMU_WHEEL["radius"]), width=np.full(n, CMU_WHEEL["width"]),
-        grouser_height=np.array([CMU_WHEEL["grouser_height"][g] for g in group]), grouser_count=np.zeros(n),
+        gravity=np.full(n, EARTH_GRAVITY), radius=np.full(n, cmu_k10.RADIUS), width=np.full(n, cmu_k10.WIDTH),
+        grouser_height=np.array([cmu_k10.GROUSER_HEIGHT[g] for g in group]), grouser_count=np.zeros(n),
         group=group,
         responses={"drawbar_pull": cols("drawbar_pull"), "lateral_force": -cols("lateral_force"),
                    "sinkage": cols("sinkage"), "torque": np.full(n, np.nan)},

@@ -285,14 +285,14 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
     gravity, load: :func:`rig_configuration`), the frequency law that explains them; a markdown + JSON report in
     ``report`` (if given).
 
-    results: finished runs as read by the caller (``wheelsoil.cases.results.load_result``): each with ``case``
-    (its case file: ``wheel_geometry()``, ``wheel.rigid``, ``soil.gravity_vector``, ``test``), ``info`` and
-    ``series``, as :func:`runs_from_results` reads them; source: what they are, for titles and errors (e.g. the
+    results: finished runs as read by the caller (``wheelsoil.cases.results.load_result``): each with ``wheel``
+    (its :class:`~wheelsoil.flexwheel.geometry.WheelGeometry`), ``case`` (its case file: ``wheel.rigid``,
+    ``soil.gravity_vector``, ``test``), ``info`` and ``series``, as :func:`runs_from_results` reads them; source: what they are, for titles and errors (e.g. the
     sweep folder). Validation reads results through this interface and does not import the case layer."""
     results = list(results)
     if not results:
         raise WheelsoilInputError(f"{source} holds no finished runs; run 'wheelsoil batch' first")
-    wheels = {wheel_counts(r.case.wheel_geometry()) for r in results}
+    wheels = {wheel_counts(r.wheel) for r in results}
     if len(wheels) != 1:
         raise WheelsoilInputError(f"{source} use different wheels {sorted(wheels)}; the frequency laws "
                                   "compare runs of one wheel")

@@ -1,0 +1,83 @@
+"""From a validated case to the solver's specs: the one place where case keys become solver inputs.
+
+A case (:class:`~wheelsoil.cases.schema.CaseFile`) says what a user asked for, section by section; the solver
+takes three specs, each of which checks its own ranges (:mod:`wheelsoil.ranges`) and defaults from the same
+parameter set (:mod:`wheelsoil.parameters.smoke`):
+
+* :func:`bed_spec` -- ``[soil]`` and ``case.seed`` -> :class:`~wheelsoil.granular.bed.BedSpec`;
+* :func:`wheel_geometry` -- ``[wheel]`` over its preset -> :class:`~wheelsoil.flexwheel.geometry.WheelGeometry`;
+* :func:`testbed_spec` -- ``[test]``, ``[contact]``, ``[output]``, ``soil.time_step`` and the wheel's
+  ``rigid``/``damping`` -> :class:`~wheelsoil.coupling.testbed.TestbedSpec`.
+
+The schema calls :func:`specs` when it validates a case, so the solver's cross-checks (particles against the
+bin, the wheel against the bin, the drive against a static bin) run before any work.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from wheelsoil.coupling.testbed import TestbedSpec
+from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, preset
+from wheelsoil.granular.bed import BedSpec
+from wheelsoil.material import Material, PairProperties
+from wheelsoil.parameters import smoke
+
+if TYPE_CHECKING:  # type hints only: the schema imports this module
+    from .schema import CaseFile
+
+#: Wheel keys that replace the preset's value when given (None: keep the preset's).
+WHEEL_KEYS = ("element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
+              "spoke_bow", "spoke_model", "grouser_count", "grouser_height", "grouser_thickness", "grouser_angle",
+              "hub_mass")
+
+
+def bed_spec(case: CaseFile) -> BedSpec:
+    """The soil bed of the case's ``[soil]`` section (and ``case.seed``)."""
+    s = case.soil
+    return BedSpec(
+        length=s.length, width=s.width, depth=s.depth, diameter_min=s.diameter_min,
+        diameter_max=s.diameter_max, gravity=s.gravity_vector,
+        material=Material(smoke.SOIL_MATERIAL.name, s.youngs_modulus, s.poisson_ratio, s.density),
+        pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
+        seed=case.case.seed, max_settle_time=s.max_settle_time, periodic=s.periodic,
+    )
+
+
+def wheel_geometry(case: CaseFile) -> WheelGeometry:
+    """The wheel of the case's ``[wheel]`` section: its preset with every given key replaced."""
+    w = case.wheel
+    base = preset(w.preset)
+    changes = {k: getattr(w, k) for k in WHEEL_KEYS if getattr(w, k) is not None}
+    if w.spoke_rows is not None:
+        changes["spoke_rows"] = tuple(SpokeRow(*row) for row in w.spoke_rows)
+    if any(v is not None for v in (w.youngs_modulus, w.poisson_ratio, w.density)):
+        m = base.material
+        changes["material"] = Material(
+            f"{base.name} material (case)",
+            youngs_modulus=w.youngs_modulus if w.youngs_modulus is not None else m.youngs_modulus,
+            poisson_ratio=w.poisson_ratio if w.poisson_ratio is not None else m.poisson_ratio,
+            density=w.density if w.density is not None else m.density)
+    return replace(base, **changes)
+
+
+def testbed_spec(case: CaseFile) -> TestbedSpec:
+    """What the rig does: the case's ``[test]``, ``[contact]`` and ``[output]`` sections, ``soil.time_step`` and
+    ``wheel.rigid``/``wheel.damping``."""
+    t, o, c = case.test, case.output, case.contact
+    return TestbedSpec(
+        slip=t.slip, slip_angle=t.slip_angle, load=t.load, angular_velocity=t.angular_velocity,
+        lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
+        drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
+        windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
+        sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
+        steady_checks=o.steady_checks, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
+        damping=case.wheel.damping, axle_damping=t.axle_damping,
+        pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
+    )
+
+
+def specs(case: CaseFile) -> tuple[BedSpec, WheelGeometry, TestbedSpec]:
+    """(bed, wheel, test) of a case: what :class:`~wheelsoil.coupling.testbed.Testbed` is made from."""
+    return bed_spec(case), wheel_geometry(case), testbed_spec(case)
