@@ -160,12 +160,10 @@ class WheelContact(Interaction):
         self.wheel_skin = self._wheel_skin_request or 4.0 * scene.skin
         self.skin = scene.skin + self.wheel_skin  # candidate margin
         self.r_max = float(radii.max())
-        cell = 2.0 * self.r_max + self.skin
-        extent = scene.domain_max - scene.domain_min
-        self.dims = [int(v) for v in np.maximum(1, np.ceil(extent / cell))]
-        self.origin = scene.domain_min.tolist()
-        self.inv_cell = 1.0 / cell
-        n_cells = int(np.prod(self.dims))
+        # the soil's own grid: a facet is binned into every cell its box grown by r_max + skin meets, and a
+        # sphere reads only its cell, so any cell edge works
+        self.grid = scene.grid
+        n_cells = self.grid.n_cells
         a = self._arrays
         a.clear()
         a["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
@@ -187,20 +185,23 @@ class WheelContact(Interaction):
         w = self.structure.device_arrays()
         a = self._arrays
         sf = self.surface
-        dims = ivec3(*self.dims)
-        origin = vec3(*self.origin)
+        self.grid = scene.grid  # the scene may have rebuilt its device state (same cells unless its spheres changed)
+        if self.grid.n_cells != a["cell_count"].shape[0]:
+            a["cell_count"] = ti.ndarray(ti.i32, shape=self.grid.n_cells)
+            a["cell_start"] = ti.ndarray(ti.i32, shape=self.grid.n_cells + 1)
+        origin, inv_cell, dims = self.grid.kernel_args()
         pad = self.r_max + self.skin
-        k.facet_cell_ranges(w["x"], self._tri, self._half_t, sf.n_facets, pad, origin, self.inv_cell, dims,
+        k.facet_cell_ranges(w["x"], self._tri, self._half_t, sf.n_facets, pad, origin, inv_cell, dims,
                             self._lo, self._hi, a["cell_count"])
         total = exclusive_scan(a["cell_count"], a["cell_start"])
         cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
         cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
         k.fill_facet_cells(sf.n_facets, dims, self._lo, self._hi, a["cell_start"], cell_fill, cell_facets)
-        k.count_candidates(ds.x, ds.radius, self.skin, origin, self.inv_cell, dims, a["cell_start"], cell_facets,
+        k.count_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
                            w["x"], self._tri, self._half_t, a["count"], a["hist_count"])
         n_cand = exclusive_scan(a["count"], a["start"])
         cand = self._buffer("cand", ti.i32, max(n_cand, 1))
-        k.fill_candidates(ds.x, ds.radius, self.skin, origin, self.inv_cell, dims, a["cell_start"], cell_facets,
+        k.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
                           w["x"], self._tri, self._half_t, a["start"], cand)
         facet_entries = self._buffer("facet_entries", ti.i32, max(n_cand, 1))
         self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, self._facet_start,

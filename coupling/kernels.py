@@ -2,8 +2,8 @@
 
 Two kinds of work:
 
-* *Rebuild* (when particles or the wheel have moved far enough): bin the contact facets into a
-  uniform grid, list for every particle the facets within its reach plus a skin (its *candidates*,
+* *Rebuild* (when particles or the wheel have moved far enough): bin the contact facets into the
+  scene's uniform grid (:mod:`wheelsoil.granular.grid`, the cells the soil's neighbour search uses), list for every particle the facets within its reach plus a skin (its *candidates*,
   sorted by facet so that results do not depend on thread scheduling), compact the particles that
   have candidates into an *active* list, and transpose the candidate list per facet.
 * *Every step* (:func:`wheel_contacts`, one launch), in phases, each a Taichi function:
@@ -21,6 +21,7 @@ import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
 from wheelsoil.granular.contact import hertz_mindlin
+from wheelsoil.granular.grid import cell_coords, cell_index
 from wheelsoil.granular.neighbors import sort_run
 from wheelsoil.taichi_types import ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
 
@@ -36,17 +37,6 @@ RES_FORCE, RES_MOMENT, RES_FORCE_SUM, RES_MOMENT_SUM, RES_SAMPLES = range(5)
 @ti.func
 def _corners(xw: ti.template(), tri: ti.template(), s: ti.i32):
     return xw[tri[s, 0]], xw[tri[s, 1]], xw[tri[s, 2]]
-
-
-@ti.func
-def _cell_of(p: vec3, origin: vec3, inv_cell: ti.f64, dims: ivec3) -> ivec3:
-    c = ti.cast(ti.floor((p - origin) * inv_cell), ti.i32)
-    return ti.max(0, ti.min(c, dims - 1))
-
-
-@ti.func
-def _flat(c: ivec3, dims: ivec3) -> ti.i32:
-    return (c[0] * dims[1] + c[1]) * dims[2] + c[2]
 
 
 @ti.kernel
@@ -66,10 +56,10 @@ def facet_cell_ranges(
         l = ivec3(1, 1, 1)
         h = ivec3(0, 0, 0)  # empty unless the box meets the grid
         if (mx >= origin).all() and (mn <= top).all():
-            l = _cell_of(mn, origin, inv_cell, dims)
-            h = _cell_of(mx, origin, inv_cell, dims)
+            l = cell_coords(mn, origin, inv_cell, dims)
+            h = cell_coords(mx, origin, inv_cell, dims)
             for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
-                ti.atomic_add(cell_count[_flat(ivec3(i, j, k), dims)], 1)
+                ti.atomic_add(cell_count[cell_index(ivec3(i, j, k), dims)], 1)
         lo[s] = l
         hi[s] = h
 
@@ -85,7 +75,7 @@ def fill_facet_cells(
         l = lo[s]
         h = hi[s]
         for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
-            c = _flat(ivec3(i, j, k), dims)
+            c = cell_index(ivec3(i, j, k), dims)
             cell_facets[cell_start[c] + ti.atomic_add(cell_fill[c], 1)] = s
 
 
@@ -107,7 +97,7 @@ def count_candidates(
     A particle with no candidates forgets its wheel-contact history (it has left the wheel)."""
     most = 0
     for i in x:
-        c = _flat(_cell_of(x[i], origin, inv_cell, dims), dims)
+        c = cell_index(cell_coords(x[i], origin, inv_cell, dims), dims)
         k = 0
         for q in range(cell_start[c], cell_start[c + 1]):
             s = cell_facets[q]
@@ -129,7 +119,7 @@ def fill_candidates(
         e0 = start[i]
         e1 = start[i + 1]
         if e1 > e0:
-            c = _flat(_cell_of(x[i], origin, inv_cell, dims), dims)
+            c = cell_index(cell_coords(x[i], origin, inv_cell, dims), dims)
             k = e0
             for q in range(cell_start[c], cell_start[c + 1]):
                 s = cell_facets[q]

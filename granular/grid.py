@@ -8,8 +8,6 @@ fastest, then y, then z (:func:`cell_index`). Points outside the grid fall into 
 divides the period exactly, so that the cells wrap around (:meth:`UniformGrid.covering`).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 
@@ -32,7 +30,7 @@ class UniformGrid:
     dims: tuple[int, int, int]
 
     @classmethod
-    def covering(cls, lo, hi, cell: float, *, period: float = 0.0) -> UniformGrid:
+    def covering(cls, lo, hi, cell: float, *, period: float = 0.0) -> "UniformGrid":
         """The grid of cells of edge at least ``cell`` [m] over the box [lo, hi]; with ``period`` > 0 the domain is
         periodic along x with that length, and the edge is stretched to divide it exactly (at least 3 cells)."""
         lo = np.asarray(lo, float).reshape(3)

@@ -1,6 +1,7 @@
 """Uniform-grid neighbour search with Verlet lists that carry contact history across rebuilds.
 
-Particles are binned into cubic cells of edge ``cell_size`` >= 2 r_max + skin by a counting sort
+Particles are binned into the cells of the scene's :class:`~.grid.UniformGrid` (edge ``cell_size`` >= 2 r_max +
+skin) by a counting sort
 (integer atomics only), then every particle gathers the partners j > i within r_i + r_j + skin from
 the 27 surrounding cells into its own row of a fixed-width list (each pair once: its owner is the
 lower index). Rows are sorted by partner index, which makes the force summation order -- and hence
@@ -30,6 +31,8 @@ from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, i
     vec4,
 )
 
+from .grid import cell_coords, cell_index
+
 
 @ti.func
 def nearest_image(d: vec3, period: ti.f64, inv_period: ti.f64) -> vec3:
@@ -52,12 +55,6 @@ def wrap_positions(x: nd_vec3, x_r: nd_vec4, origin_x: ti.f64, period: ti.f64):
         x_r[i][0] = origin_x + u
 
 
-@ti.func
-def cell_coords(p: vec3, origin: vec3, inv_cell: ti.f64, dims: ivec3) -> ivec3:
-    c = ti.cast(ti.floor((p - origin) * inv_cell), ti.i32)
-    return ti.max(ti.min(c, dims - 1), 0)
-
-
 @ti.kernel
 def bin_particles(
     x: nd_vec3, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_of: nd_i32, cell_count: nd_i32
@@ -66,8 +63,7 @@ def bin_particles(
     for c in cell_count:
         cell_count[c] = 0
     for i in x:
-        c = cell_coords(x[i], origin, inv_cell, dims)
-        cid = (c[2] * dims[1] + c[1]) * dims[0] + c[0]
+        cid = cell_index(cell_coords(x[i], origin, inv_cell, dims), dims)
         cell_of[i] = cid
         ti.atomic_add(cell_count[cid], 1)
 
@@ -128,7 +124,7 @@ def build_neighbor_lists(
             if period > 0.0:
                 cc[0] = (cc[0] + dims[0]) % dims[0]
             if (cc >= 0).all() and (cc < dims).all():
-                cid = (cc[2] * dims[1] + cc[1]) * dims[0] + cc[0]
+                cid = cell_index(cc, dims)
                 for s in range(cell_start[cid], cell_start[cid + 1]):
                     j = sorted_ids[s]
                     if j > i:
@@ -138,14 +134,7 @@ def build_neighbor_lists(
                                 nbr[i, count] = j
                             count += 1
         kept = ti.min(count, width)
-        # insertion sort of the (short) row by partner index
-        for a in range(1, kept):
-            key = nbr[i, a]
-            b = a - 1
-            while b >= 0 and nbr[i, b] > key:
-                nbr[i, b + 1] = nbr[i, b]
-                b -= 1
-            nbr[i, b + 1] = key
+        sort_row(nbr, i, 0, kept)  # by partner index
         nbr_count[i] = kept
         ti.atomic_max(most, count)
     return most
@@ -168,16 +157,41 @@ def near_walls(x: nd_vec3, radius: nd_f64, wall_point: nd_vec3, wall_normal: nd_
 
 
 @ti.func
-def sort_run(values: ti.template(), lo, hi):
-    """Sort ``values[lo:hi]`` (a 1-D integer array) ascending in place: an insertion sort, for the
-    short runs of a neighbour or candidate list (stable, no scratch memory, one thread per run)."""
+def sort_row(values: ti.template(), row, lo, hi):
+    """Sort ``values[row, lo:hi]`` (a 2-D integer array; a 1-D one, ``values[lo:hi]``, with ``row`` ignored)
+    ascending in place: an insertion sort, for the short runs of a neighbour or candidate list (stable, no
+    scratch memory, one thread per run)."""
     for a in range(lo + 1, hi):
-        key = values[a]
+        key = _at(values, row, a)
         b = a - 1
-        while b >= lo and values[b] > key:
-            values[b + 1] = values[b]
+        while b >= lo and _at(values, row, b) > key:
+            _put(values, row, b + 1, _at(values, row, b))
             b -= 1
-        values[b + 1] = key
+        _put(values, row, b + 1, key)
+
+
+@ti.func
+def sort_run(values: ti.template(), lo, hi):
+    """Sort ``values[lo:hi]`` (a 1-D integer array) ascending in place (:func:`sort_row`)."""
+    sort_row(values, 0, lo, hi)
+
+
+@ti.func
+def _at(values: ti.template(), row, k):
+    out = 0
+    if ti.static(len(values.shape) == 2):
+        out = values[row, k]
+    else:
+        out = values[k]
+    return out
+
+
+@ti.func
+def _put(values: ti.template(), row, k, value):
+    if ti.static(len(values.shape) == 2):
+        values[row, k] = value
+    else:
+        values[k] = value
 
 
 # ---------------------------------------------------------------------------------------------

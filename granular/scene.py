@@ -25,6 +25,7 @@ import taichi as ti
 
 from . import forces, fused_step, integrator, neighbors, runtime
 from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
+from .grid import UniformGrid
 from .materials import (
     LUNAR_SOIL_SIMULANT,
     SOIL_SOIL,
@@ -296,6 +297,12 @@ class Scene:
         """The device arrays the scene steps (moves the state to the device if needed)."""
         d = self._to_device()
         return DeviceState(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["f"], d["t"], d["f_ext"], d["t_ext"])
+
+    @property
+    def grid(self) -> UniformGrid:
+        """The uniform grid over the domain that the neighbour search bins the spheres in (interactions such as
+        the wheel contact bin their own objects in the same cells)."""
+        return self._to_device()["grid"]
 
     def add_spheres(self, positions, radii, velocities=None, angular_velocities=None, *, wall_history=None) -> slice:
         """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
@@ -668,20 +675,7 @@ class Scene:
             raise WheelsoilInputError(
                 f"cell_size = {cell!r} m is smaller than the interaction reach 2 r_max + skin = {reach:.4g} m"
             )
-        extent = self.domain_max - self.domain_min
-        if self.periodic_x:
-            # cubic cells whose edge divides the period exactly, so that the cells wrap around in x
-            along = int(math.floor(self.period / cell * (1 + 1e-12)))
-            if along < 3:
-                raise WheelsoilInputError(
-                    f"the periodic length {self.period:g} m holds {along} neighbour cells of {cell:.4g} m; it must "
-                    f"hold at least 3 (a period of at least {3 * cell:.4g} m)")
-            cell = self.period / along
-        dims = np.maximum(1, np.ceil(extent / cell).astype(np.int64))
-        if self.periodic_x:
-            dims[0] = along
-        if int(np.prod(dims)) > 2**31 - 2:
-            raise WheelsoilInputError(f"neighbour grid of {dims.tolist()} cells is too large; raise cell_size")
+        grid = UniformGrid.covering(self.domain_min, self.domain_max, cell, period=self.period)
         width = neighbor_row_width(r_min, r_max, skin)
         h = self._hist
         mass = self.masses
@@ -689,8 +683,7 @@ class Scene:
             "n": n,
             "r_min": r_min,
             "skin": skin,
-            "cell": cell,
-            "dims": [int(v) for v in dims],
+            "grid": grid,
             "e_eff": effective_modulus(self.material, self.material),
             "g_eff": effective_shear_modulus(self.material, self.material),
             "beta": self.pair.damping_ratio,
@@ -720,7 +713,7 @@ class Scene:
         # the contact view: (x, r), (v, m), (omega, I) side by side for the force pass
         d["x_r"], d["v_m"], d["w_i"] = (ti.Vector.ndarray(4, ti.f64, shape=max(n, 1)) for _ in range(3))
         integrator.contact_view(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["x_r"], d["v_m"], d["w_i"])
-        n_cells = int(np.prod(dims))
+        n_cells = grid.n_cells
         d["cell_of"] = ti.ndarray(ti.i32, shape=n)
         d["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
         d["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
@@ -793,17 +786,17 @@ class Scene:
 
     def _rebuild_neighbors(self) -> None:
         d = self._dev
-        origin = self.domain_min.tolist()
+        grid = d["grid"]
         if self.periodic_x:
-            neighbors.wrap_positions(d["x"], d["x_r"], origin[0], self.period)
-        inv_cell = 1.0 / d["cell"]
-        neighbors.bin_particles(d["x"], origin, inv_cell, d["dims"], d["cell_of"], d["cell_count"])
+            neighbors.wrap_positions(d["x"], d["x_r"], grid.origin[0], self.period)
+        origin, inv_cell, dims = grid.kernel_args()
+        neighbors.bin_particles(d["x"], origin, inv_cell, dims, d["cell_of"], d["cell_count"])
         neighbors.exclusive_scan(d["cell_count"], d["cell_start"])
         neighbors.scatter_to_cells(d["cell_of"], d["cell_start"], d["cell_count"], d["sorted_ids"])
 
         def build_rows() -> int:
             return neighbors.build_neighbor_lists(
-                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, d["dims"], d["skin"],
+                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, dims, d["skin"],
                 d["period"], d["inv_period"], d["nbr"], d["count"],
             )
 
