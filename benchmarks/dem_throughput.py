@@ -190,7 +190,7 @@ def memory_check(n_target: int = 388_026) -> dict:
     scene.step(20)
     return {
         "particles": scene.n_particles,
-        "neighbor_row_width": scene._dev["width"],
+        "neighbor_row_width": scene.device.neighbor_list.width,
         "peak_rss_mib": peak_rss_mib(),
         "rss_before_stepping_mib": before,
         "seconds_for_20_steps": time.perf_counter() - t0,

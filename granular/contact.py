@@ -36,13 +36,40 @@ partner receives the negated force and rolling torque (see :mod:`.forces`).
 
 
 import math
+from dataclasses import dataclass
 
 import taichi as ti
+
+from .materials import Material, PairProperties, effective_modulus, effective_shear_modulus
 
 vec3 = ti.types.vector(3, ti.f64)
 
 #: 2 sqrt(5/6), the prefactor of the damping forces (eqs. 5-6).
 DAMPING_PREFACTOR = 2.0 * math.sqrt(5.0 / 6.0)
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """The sphere--sphere pair constants of one soil, computed once from its material and pair properties.
+
+    e_eff, g_eff: E* and G* of two spheres of the material [Pa] (eqs. 10, 12); beta: the damping ratio of the
+    restitution (eq. 9); mu_s, mu_r: sliding and rolling friction; period, inv_period: the length [m] of a
+    domain periodic along x and its inverse (both 0 otherwise: nearest-image distances switched off).
+    """
+
+    e_eff: float
+    g_eff: float
+    beta: float
+    mu_s: float
+    mu_r: float
+    period: float = 0.0
+    inv_period: float = 0.0
+
+    @classmethod
+    def of(cls, material: Material, pair: PairProperties, period: float = 0.0) -> "ContactParameters":
+        return cls(effective_modulus(material, material), effective_shear_modulus(material, material),
+                   pair.damping_ratio, pair.static_friction, pair.rolling_friction, float(period),
+                   1.0 / period if period > 0 else 0.0)
 
 
 @ti.func

@@ -23,48 +23,18 @@ from typing import Callable
 import numpy as np
 import taichi as ti
 
-from . import forces, fused_step, integrator, neighbors, runtime
-from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
+from . import integrator, runtime
+from .contact import ContactParameters
+from .errors import SimulationUnstableError, WheelsoilInputError
 from .grid import UniformGrid
-from .materials import (
-    LUNAR_SOIL_SIMULANT,
-    SOIL_SOIL,
-    SOIL_STEEL,
-    STEEL,
-    Material,
-    PairProperties,
-    effective_modulus,
-    effective_shear_modulus,
-)
+from .materials import LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL, Material, PairProperties, effective_modulus
+from .neighbor_list import NeighborList, PairList, row_width
+from .particles import DeviceState, ParticleArrays
+from .stepper import Stepper
 from .timestep import TimeStepEstimate, estimate_time_step
+from .walls import MAX_WALLS, Wall, WallArrays
 
-
-#: Most planar walls per scene: each particle keeps a 32-bit mask of the walls it touches.
-MAX_WALLS = 31
-
-
-@dataclass(frozen=True)
-class DeviceState:
-    """The particle state arrays a scene steps (Taichi ndarrays, one row per sphere).
-
-    For :class:`Interaction` objects that add forces from bodies the scene does not own; valid
-    until the next structural edit of the scene (adding or removing spheres or walls). An
-    interaction reads the state and adds its contact forces and torques to ``external_force`` and
-    ``external_torque`` (the step adds them to the contact forces and clears them); it must not write
-    ``x``, ``v`` or ``w``: the sphere--sphere force pass reads a copy of them made at each drift (the
-    contact view, :func:`wheelsoil.granular.integrator.write_contact_view`).
-    """
-
-    x: ti.Ndarray  # positions [m]
-    v: ti.Ndarray  # velocities [m/s]
-    w: ti.Ndarray  # angular velocities [rad/s]
-    radius: ti.Ndarray  # [m]
-    mass: ti.Ndarray  # [kg]
-    inertia: ti.Ndarray  # moments of inertia [kg m^2]
-    force: ti.Ndarray  # contact force of the last step [N]
-    torque: ti.Ndarray  # contact torque of the last step [N m]
-    external_force: ti.Ndarray  # an interaction adds its contact forces here [N]
-    external_torque: ti.Ndarray  # an interaction adds its contact torques here [N m]
+__all__ = ["DeviceParts", "DeviceState", "Interaction", "MAX_WALLS", "Scene", "Wall"]
 
 
 class Interaction:
@@ -92,19 +62,6 @@ class Interaction:
         return 0
 
 
-@dataclass(frozen=True)
-class Wall:
-    """An infinite rigid plane. ``normal`` points into the side where particles live.
-
-    ``material=None`` makes the wall perfectly rigid (E = infinity).
-    """
-
-    point: tuple[float, float, float]
-    normal: tuple[float, float, float]
-    material: Material | None
-    pair: PairProperties
-
-
 def _as_array(name: str, value, shape_tail: tuple[int, ...], n: int | None = None) -> np.ndarray:
     arr = np.asarray(value, dtype=np.float64)
     if arr.ndim == len(shape_tail):  # a single item
@@ -121,15 +78,16 @@ def _as_array(name: str, value, shape_tail: tuple[int, ...], n: int | None = Non
     return np.ascontiguousarray(arr)
 
 
-def neighbor_row_width(r_min: float, r_max: float, skin: float) -> int:
-    """Upper estimate of the number of partners within r_i + r_j + skin of the largest sphere.
+@dataclass
+class DeviceParts:
+    """A scene on the device, part by part (made from the host state, dropped before a structural edit)."""
 
-    Spheres of radius r_min whose centres lie within r_max + r_min + skin occupy at most 74 % (the
-    densest packing) of the shell between r_max and r_max + 2 r_min + skin. Rows that still overflow
-    are widened automatically.
-    """
-    outer = r_max + 2.0 * r_min + skin
-    return int(math.ceil(0.74 * (outer**3 - r_max**3) / r_min**3)) + 2
+    particles: ParticleArrays
+    neighbor_list: NeighborList
+    walls: WallArrays
+    params: ContactParameters
+    stepper: Stepper
+    health: ti.Ndarray  # state_health's four figures
 
 
 class Scene:
@@ -214,7 +172,7 @@ class Scene:
         #: Run the force pass and the integration as one launch per step when nothing else acts on
         #: the particles (granular.fused_step; the same arithmetic, fewer passes over memory).
         self.fuse_steps = True
-        # host copy of the state (authoritative while self._dev is None)
+        # host copy of the state (authoritative while self._device is None)
         self._x = np.zeros((0, 3))
         self._v = np.zeros((0, 3))
         self._w = np.zeros((0, 3))
@@ -223,7 +181,7 @@ class Scene:
         self._f = np.zeros((0, 3))
         self._t = np.zeros((0, 3))
         self._hist: dict | None = None  # pair list with tangential history, wall history (host copy)
-        self._dev: dict | None = None
+        self._device: DeviceParts | None = None
 
     # ------------------------------------------------------------------ building the scene
     def add_wall(
@@ -295,14 +253,19 @@ class Scene:
 
     def device_state(self) -> DeviceState:
         """The device arrays the scene steps (moves the state to the device if needed)."""
-        d = self._to_device()
-        return DeviceState(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["f"], d["t"], d["f_ext"], d["t_ext"])
+        return self._to_device().particles.device_state()
+
+    @property
+    def device(self) -> DeviceParts:
+        """The scene's parts on the device: particles, neighbour list, walls, pair constants, stepper (moves the
+        state to the device if needed; valid until the next structural edit)."""
+        return self._to_device()
 
     @property
     def grid(self) -> UniformGrid:
         """The uniform grid over the domain that the neighbour search bins the spheres in (interactions such as
         the wheel contact bin their own objects in the same cells)."""
-        return self._to_device()["grid"]
+        return self._to_device().neighbor_list.grid
 
     def add_spheres(self, positions, radii, velocities=None, angular_velocities=None, *, wall_history=None) -> slice:
         """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
@@ -521,9 +484,11 @@ class Scene:
         if self.n_particles == 0:
             raise WheelsoilInputError("the scene has no spheres to step")
         dt = self.time_step
-        d = self._to_device()
-        gx, gy, gz = (float(c) for c in self.gravity)
-        half_skin2 = (0.5 * d["skin"]) ** 2
+        device = self._to_device()
+        stepper = device.stepper
+        gravity = tuple(float(c) for c in self.gravity)
+        half_skin2 = (0.5 * device.neighbor_list.skin) ** 2
+        external = bool(self.interactions)
         # The force pass, the closing half kick and the next step's opening kick and drift run as one
         # launch (fused_step), except before a step whose state is read; interactions evaluate their
         # contacts between the drift and that launch.
@@ -532,11 +497,7 @@ class Scene:
         largest = 0.0
         for k in range(n):
             if not drifted:
-                integrator.kick_drift_graph(
-                    d["x"], d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], d["mobile"], gx, gy, gz, dt, d["x_ref"],
-                    d["r"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
-                )
-                largest = float(d["step_result"][0])
+                largest = stepper.kick_drift(gravity, dt)
             if largest > half_skin2:
                 self._rebuild_neighbors()
             n_external = 0
@@ -551,47 +512,17 @@ class Scene:
                     or step_number % self.check_interval == 0
                     or (callback is not None and callback_every and (k + 1) % callback_every == 0)
                 )
-                self._n_contacts, largest = self._contact_step(dt, gx, gy, gz, drift=not state_read)
+                self._n_contacts, largest = stepper.fused(gravity, dt, external=external, drift=not state_read)
                 self._n_contacts += n_external
                 drifted = not state_read
             else:
-                self._n_contacts = self._compute_forces(dt) + n_external
-                integrator.kick_graph(d["v"], d["w"], d["f"], d["t"], d["m"], d["I"], d["mobile"], gx, gy, gz, dt)
+                self._n_contacts = stepper.forces_and_kick(gravity, dt, external=external) + n_external
             self.time += dt
             self.steps_taken += 1
             if self.steps_taken % self.check_interval == 0:
                 self.check_health()
             if callback is not None and callback_every and (k + 1) % callback_every == 0:
                 callback(self)
-
-    def _contact_step(self, dt: float, gx: float, gy: float, gz: float, drift: bool) -> tuple[int, float]:
-        d = self._dev
-        pairs = d["pairs"]
-        fused_step.contact_step_graph(
-            d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["mobile"],
-            pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
-            d["rev_start"],
-            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
-            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["period"], d["inv_period"], int(bool(self.interactions)), d["f_ext"], d["t_ext"], d["f"], d["t"],
-            gx, gy, gz, int(drift), d["x_ref"], d["x_r"], d["v_m"], d["w_i"], d["step_result"],
-        )
-        result = d["step_result"]
-        return int(result[0]), float(result[1])
-
-    def _compute_forces(self, dt: float) -> int:
-        d = self._dev
-        pairs = d["pairs"]
-        forces.contact_forces_graph(
-            d["x_r"], d["v_m"], d["w_i"],
-            pairs["start"], pairs["j"], pairs["xi"], pairs["rev"], pairs["touching"], pairs["partner_slot"],
-            d["rev_start"],
-            d["wall_point"], d["wall_normal"], d["wall_props"], d["xi_wall"], d["wall_touching"], d["wall_near"],
-            d["e_eff"], d["g_eff"], d["beta"], self.pair.static_friction, self.pair.rolling_friction, dt,
-            d["period"], d["inv_period"], int(bool(self.interactions)), d["f_ext"], d["t_ext"], d["f"], d["t"],
-            d["step_result"],
-        )
-        return int(d["step_result"][0])
 
     # ------------------------------------------------------------------ checkpoints
     _STATE_SCALARS = ("time", "steps_taken", "neighbor_rebuilds", "_n_contacts")
@@ -619,7 +550,7 @@ class Scene:
                 f"the saved state has {len(r)} spheres of other radii than this scene's {self.n_particles}; "
                 "it belongs to another bed"
             )
-        self._dev = None
+        self._device = None
         self._r = r.copy()
         self._mobile = np.array(state["mobile"], float) if "mobile" in state else np.ones(len(r))
         self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
@@ -634,12 +565,12 @@ class Scene:
 
         Returns the health figures: ``kinetic_energy`` [J], ``max_speed`` [m/s].
         """
-        d = self._to_device()
-        out = d["health"]
+        device = self._to_device()
+        p, out = device.particles, device.health
         lo, hi = self.domain_min.tolist(), self.domain_max.tolist()
         if self.periodic_x:  # centres wrap at each rebuild; in between they may cross the ends
             lo[0], hi[0] = -math.inf, math.inf
-        integrator.state_health(d["x"], d["v"], d["w"], d["m"], d["I"], lo, hi, out)
+        integrator.state_health(p.x, p.v, p.w, p.m, p.I, lo, hi, out)
         bad, outside, vmax2, energy = out.to_numpy()
         where = f"at t = {self.time:.6g} s (step {self.steps_taken})"
         if bad:
@@ -653,7 +584,7 @@ class Scene:
                 f"{self.domain_max.tolist()}] m {where}; the bin may be missing a wall or the run blew up"
             )
         vmax = math.sqrt(vmax2)
-        limit = 0.2 * d["r_min"] / self.time_step
+        limit = 0.2 * float(self._r.min()) / self.time_step
         if vmax > limit:
             raise SimulationUnstableError(
                 f"energy blow-up {where}: a particle moves at {vmax:.3g} m/s, more than 0.2 r_min per step "
@@ -663,9 +594,9 @@ class Scene:
         return {"kinetic_energy": float(energy), "max_speed": vmax}
 
     # ------------------------------------------------------------------ device state
-    def _to_device(self) -> dict:
-        if self._dev is not None:
-            return self._dev
+    def _to_device(self) -> DeviceParts:
+        if self._device is not None:
+            return self._device
         n = self.n_particles
         r_min, r_max = float(self._r.min()), float(self._r.max())
         skin = self.skin
@@ -676,180 +607,34 @@ class Scene:
                 f"cell_size = {cell!r} m is smaller than the interaction reach 2 r_max + skin = {reach:.4g} m"
             )
         grid = UniformGrid.covering(self.domain_min, self.domain_max, cell, period=self.period)
-        width = neighbor_row_width(r_min, r_max, skin)
         h = self._hist
-        mass = self.masses
-        d: dict = {
-            "n": n,
-            "r_min": r_min,
-            "skin": skin,
-            "grid": grid,
-            "e_eff": effective_modulus(self.material, self.material),
-            "g_eff": effective_shear_modulus(self.material, self.material),
-            "beta": self.pair.damping_ratio,
-            "period": self.period,
-            "inv_period": 1.0 / self.period if self.period > 0 else 0.0,
-        }
-
-        def vec(a):
-            arr = ti.Vector.ndarray(3, ti.f64, shape=max(len(a), 1))
-            if len(a):
-                arr.from_numpy(np.ascontiguousarray(a, dtype=np.float64))
-            return arr
-
-        def scal(a, dtype=ti.f64):
-            arr = ti.ndarray(dtype, shape=a.shape)
-            arr.from_numpy(np.ascontiguousarray(a))
-            return arr
-
-        d["x"], d["v"], d["w"] = vec(self._x), vec(self._v), vec(self._w)
-        d["f"], d["t"] = vec(self._f), vec(self._t)
-        d["f_ext"], d["t_ext"] = vec(np.zeros((n, 3))), vec(np.zeros((n, 3)))
-        d["x_ref"] = vec(self._x)
-        d["r"] = scal(self._r)
-        d["mobile"] = scal(self._mobile)
-        d["m"] = scal(mass)
-        d["I"] = scal(0.4 * mass * self._r**2)
-        # the contact view: (x, r), (v, m), (omega, I) side by side for the force pass
-        d["x_r"], d["v_m"], d["w_i"] = (ti.Vector.ndarray(4, ti.f64, shape=max(n, 1)) for _ in range(3))
-        integrator.contact_view(d["x"], d["v"], d["w"], d["r"], d["m"], d["I"], d["x_r"], d["v_m"], d["w_i"])
-        n_cells = grid.n_cells
-        d["cell_of"] = ti.ndarray(ti.i32, shape=n)
-        d["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
-        d["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
-        d["sorted_ids"] = ti.ndarray(ti.i32, shape=n)
-        self._alloc_rows(d, width)
-        d["partnered"] = ti.ndarray(ti.i32, shape=n)
-        d["cursor"] = ti.ndarray(ti.i32, shape=n)
-        d["rev_start"] = ti.ndarray(ti.i32, shape=n + 1)
+        particles = ParticleArrays.upload(self._x, self._v, self._w, self._f, self._t, self._r, self._mobile,
+                                          self.material.density)
         # the pair list the first build carries the history from (the host copy, if any)
-        pairs = self._pair_buffers(max(1, len(h["pair_i"])) if h is not None else 1)
-        pairs["n_particles"] = 0
-        if h is not None and len(h["pair_i"]):
-            start = np.zeros(n + 1, np.int32)
-            start[1:] = np.cumsum(np.bincount(h["pair_i"], minlength=n))
-            pairs["start"].from_numpy(start)
-            pairs["j"].from_numpy(np.ascontiguousarray(h["pair_j"], dtype=np.int32))
-            pairs["xi"].from_numpy(np.ascontiguousarray(h["pair_xi"], dtype=np.float64))
-            pairs["touching"].from_numpy(np.any(h["pair_xi"] != 0.0, axis=1).astype(np.int32))
-            pairs["n_particles"] = n
-        d["pairs"], d["n_pairs"] = pairs, 0
-        n_walls = len(self.walls)
-        d["wall_point"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
-        d["wall_normal"] = ti.Vector.ndarray(3, ti.f64, shape=n_walls)
-        if n_walls:
-            d["wall_point"].from_numpy(np.array([w.point for w in self.walls], dtype=np.float64))
-            d["wall_normal"].from_numpy(np.array([w.normal for w in self.walls], dtype=np.float64))
-        props = np.zeros((max(n_walls, 1), 5))
-        for k, w in enumerate(self.walls):
-            props[k, forces.WALL_E_EFF] = effective_modulus(self.material, w.material)
-            props[k, forces.WALL_G_EFF] = effective_shear_modulus(self.material, w.material)
-            props[k, forces.WALL_BETA] = w.pair.damping_ratio
-            props[k, forces.WALL_MU_S] = w.pair.static_friction
-            props[k, forces.WALL_MU_R] = w.pair.rolling_friction
-        d["wall_props"] = scal(props)
-        d["xi_wall"] = ti.Vector.ndarray(3, ti.f64, shape=(n, max(n_walls, 1)))
-        d["xi_wall"].fill(0.0)
-        d["wall_touching"] = ti.ndarray(ti.i32, shape=n)
-        d["wall_touching"].fill(0)
-        if h is not None and n_walls:
-            d["xi_wall"].from_numpy(np.ascontiguousarray(h["xi_wall"]))
-            touching = np.any(h["xi_wall"] != 0.0, axis=2)  # (n, walls)
-            d["wall_touching"].from_numpy((touching * (1 << np.arange(n_walls))).sum(axis=1).astype(np.int32))
-        d["wall_near"] = ti.ndarray(ti.i32, shape=n)
-        d["health"] = ti.ndarray(ti.f64, shape=4)
-        d["step_result"] = ti.ndarray(ti.f64, shape=2)
-        self._dev = d
+        pairs = (PairList.from_history(n, h["pair_i"], h["pair_j"], h["pair_xi"]) if h is not None
+                 else PairList.allocate(n, 1))
+        neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs, period=self.period)
+        walls = WallArrays.upload(self.walls, self.material, n, h["xi_wall"] if h is not None else None)
+        params = ContactParameters.of(self.material, self.pair, self.period)
+        self._device = DeviceParts(particles, neighbor_list, walls, params,
+                                   Stepper(particles, neighbor_list, walls, params), ti.ndarray(ti.f64, shape=4))
         self._rebuild_neighbors()
-        return d
-
-    @staticmethod
-    def _alloc_rows(d: dict, width: int) -> None:
-        """Neighbour rows (scratch for building the pair list; they carry no history)."""
-        d["width"] = width
-        d["nbr"] = ti.ndarray(ti.i32, shape=(d["n"], width))
-        d["count"] = ti.ndarray(ti.i32, shape=d["n"])
-
-    def _pair_buffers(self, capacity: int) -> dict:
-        """Arrays of a pair list with room for ``capacity`` pairs."""
-        n = self.n_particles
-        return {
-            "capacity": capacity,
-            "start": ti.ndarray(ti.i32, shape=n + 1),
-            "j": ti.ndarray(ti.i32, shape=capacity),
-            "xi": ti.Vector.ndarray(3, ti.f64, shape=capacity),
-            "touching": ti.ndarray(ti.i32, shape=capacity),
-            "rev": ti.ndarray(ti.i32, shape=capacity),
-            "rev_pair": ti.ndarray(ti.i32, shape=capacity),
-            "partner_slot": ti.ndarray(neighbors.mat23, shape=capacity),
-        }
+        return self._device
 
     def _rebuild_neighbors(self) -> None:
-        d = self._dev
-        grid = d["grid"]
-        if self.periodic_x:
-            neighbors.wrap_positions(d["x"], d["x_r"], grid.origin[0], self.period)
-        origin, inv_cell, dims = grid.kernel_args()
-        neighbors.bin_particles(d["x"], origin, inv_cell, dims, d["cell_of"], d["cell_count"])
-        neighbors.exclusive_scan(d["cell_count"], d["cell_start"])
-        neighbors.scatter_to_cells(d["cell_of"], d["cell_start"], d["cell_count"], d["sorted_ids"])
-
-        def build_rows() -> int:
-            return neighbors.build_neighbor_lists(
-                d["x"], d["r"], d["cell_start"], d["sorted_ids"], origin, inv_cell, dims, d["skin"],
-                d["period"], d["inv_period"], d["nbr"], d["count"],
-            )
-
-        most = build_rows()
-        fitted = most + max(4, most // 4)
-        if most > d["width"] or 2 * fitted < d["width"]:
-            # Rows too narrow, or far wider than needed (wide rows waste cache): refit them.
-            if fitted > 4096:
-                raise CapacityError(
-                    f"a particle has {most} neighbours with higher indices; the size ratio or skin is unreasonable"
-                )
-            self._alloc_rows(d, fitted)
-            build_rows()
-
-        # The new pair list (the rows, compact), with history carried from the current one.
-        old = d["pairs"]
-        new = d.pop("spare", None) or self._pair_buffers(1)
-        n_pairs = neighbors.exclusive_scan(d["count"], new["start"])
-        if n_pairs > new["capacity"]:
-            new = self._pair_buffers(int(n_pairs * 1.25) + 16)
-            neighbors.exclusive_scan(d["count"], new["start"])
-        neighbors.fill_pairs(
-            d["nbr"], d["count"], new["start"], new["j"], new["xi"], new["touching"],
-            old["start"], old["j"], old["xi"], old["touching"], old["n_particles"],
-        )
-        new["n_particles"] = d["n"]
-        # Partner slots by partner; zero, as the force pass expects of pairs that are apart (a pair
-        # touching now writes its slot in the next force pass).
-        neighbors.count_partners(new["j"], n_pairs, d["partnered"])
-        neighbors.exclusive_scan(d["partnered"], d["rev_start"])
-        neighbors.fill_reverse_index(new["j"], n_pairs, d["rev_start"], d["cursor"], new["rev_pair"], new["rev"])
-        new["partner_slot"].fill(0.0)
-        d["pairs"], d["spare"], d["n_pairs"] = new, old, n_pairs
-        neighbors.near_walls(d["x"], d["r"], d["wall_point"], d["wall_normal"], d["skin"], d["wall_near"])
-        integrator.copy_vec3(d["x"], d["x_ref"])
+        device = self._device
+        device.neighbor_list.rebuild(device.particles, device.walls)
         self.neighbor_rebuilds += 1
 
     def _to_host(self) -> None:
         """Copy the device state back to NumPy and drop the device arrays (before structural edits)."""
-        d = self._dev
-        if d is None:
+        device = self._device
+        if device is None:
             return
-        self._x, self._v, self._w = d["x"].to_numpy(), d["v"].to_numpy(), d["w"].to_numpy()
-        self._f, self._t = d["f"].to_numpy(), d["t"].to_numpy()
-        pairs, n_pairs = d["pairs"], d["n_pairs"]
-        owned = np.diff(pairs["start"].to_numpy())
-        self._hist = {
-            "pair_i": np.repeat(np.arange(len(owned), dtype=np.int32), owned),
-            "pair_j": pairs["j"].to_numpy()[:n_pairs],
-            "pair_xi": pairs["xi"].to_numpy()[:n_pairs],
-            "xi_wall": d["xi_wall"].to_numpy()[:, : len(self.walls)],
-        }
-        self._dev = None
+        state = device.particles.download()
+        self._x, self._v, self._w, self._f, self._t = (state[k] for k in ("x", "v", "w", "f", "t"))
+        self._hist = {**device.neighbor_list.history(), "xi_wall": device.walls.history()}
+        self._device = None
 
     # ------------------------------------------------------------------ read-back
     @property
@@ -857,9 +642,9 @@ class Scene:
         return int(self._r.shape[0])
 
     def _read(self, key: str, host: np.ndarray) -> np.ndarray:
-        if self._dev is None:
+        if self._device is None:
             return host.copy()
-        return self._dev[key].to_numpy()
+        return getattr(self._device.particles, key).to_numpy()
 
     @property
     def positions(self) -> np.ndarray:

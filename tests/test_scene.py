@@ -157,20 +157,21 @@ def test_pair_list_matches_brute_force_and_partner_runs_are_sorted():
     runs by partner with owners ascending."""
     x, r, v = random_packing()
     s = run_packing(x, r, v, steps=400)
-    d, pairs, n_pairs = s._dev, s._dev["pairs"], s._dev["n_pairs"]
+    nl = s.device.neighbor_list
+    pairs, n_pairs = nl.pairs, nl.n_pairs
     assert s.neighbor_rebuilds >= 2
-    owners = np.repeat(np.arange(s.n_particles), np.diff(pairs["start"].to_numpy()))
-    partners = pairs["j"].to_numpy()[:n_pairs]
-    x_ref = d["x_ref"].to_numpy()
+    owners = np.repeat(np.arange(s.n_particles), np.diff(pairs.start.to_numpy()))
+    partners = pairs.j.to_numpy()[:n_pairs]
+    x_ref = s.device.particles.x_ref.to_numpy()
     dist = np.linalg.norm(x_ref[:, None, :] - x_ref[None, :, :], axis=-1)
-    ii, jj = np.nonzero(np.triu(dist < r[:, None] + r[None, :] + d["skin"], k=1))
+    ii, jj = np.nonzero(np.triu(dist < r[:, None] + r[None, :] + nl.skin, k=1))
     np.testing.assert_array_equal(owners, ii)  # np.nonzero lists row-major: owner, then partner
     np.testing.assert_array_equal(partners, jj)
-    rev = pairs["rev"].to_numpy()[:n_pairs]
+    rev = pairs.rev.to_numpy()[:n_pairs]
     assert np.array_equal(np.sort(rev), np.arange(n_pairs))
     by_slot = np.empty(n_pairs, dtype=np.int64)
     by_slot[rev] = np.arange(n_pairs)  # the pair in each slot
-    rev_start = d["rev_start"].to_numpy()
+    rev_start = nl.rev_start.to_numpy()
     np.testing.assert_array_equal(np.repeat(np.arange(s.n_particles), np.diff(rev_start)), partners[by_slot])
     same_run = np.diff(partners[by_slot]) == 0
     assert np.all(np.diff(owners[by_slot])[same_run] > 0)
@@ -181,15 +182,15 @@ def test_wall_list_holds_the_walls_within_reach():
     pass checks only those); a particle touching a wall has it listed."""
     x, r, v = random_packing()
     s = run_packing(x, r, v)  # settled: many particles rest on the floor and walls
-    d = s._dev
+    device = s.device
     assert s.neighbor_rebuilds >= 2
     points = np.array([w.point for w in s.walls])
     normals = np.array([w.normal for w in s.walls])
-    gap = np.einsum("iwk,wk->iw", d["x_ref"].to_numpy()[:, None, :] - points[None], normals)
-    expected = ((gap < r[:, None] + d["skin"]) * (1 << np.arange(len(s.walls)))).sum(axis=1)
-    near = d["wall_near"].to_numpy()
+    gap = np.einsum("iwk,wk->iw", device.particles.x_ref.to_numpy()[:, None, :] - points[None], normals)
+    expected = ((gap < r[:, None] + device.neighbor_list.skin) * (1 << np.arange(len(s.walls)))).sum(axis=1)
+    near = device.walls.near.to_numpy()
     np.testing.assert_array_equal(near, expected)
-    touching = d["wall_touching"].to_numpy()
+    touching = device.walls.touching.to_numpy()
     assert np.count_nonzero(touching) > 10
     assert np.all(touching & ~near == 0)
     assert 0 < np.count_nonzero(near) < s.n_particles
@@ -224,10 +225,10 @@ def test_fused_step_follows_the_separate_kernels():
     assert len(seen[True]) == 6
     # the contact view the force pass reads is written by the drift of either path
     for s in scenes.values():
-        x_r = s._dev["x_r"].to_numpy()
+        x_r = s.device.particles.x_r.to_numpy()
         np.testing.assert_array_equal(x_r[:, :3], s.positions)
         np.testing.assert_array_equal(x_r[:, 3], s.radii)
-        np.testing.assert_array_equal(s._dev["v_m"].to_numpy()[:, 3], s.masses)
+        np.testing.assert_array_equal(s.device.particles.v_m.to_numpy()[:, 3], s.masses)
 
 
 def test_contact_history_survives_rebuilds_and_edits():
@@ -236,11 +237,11 @@ def test_contact_history_survives_rebuilds_and_edits():
     s = small_scene()
     s.add_spheres([[0.05, 0.1, 0.0099], [0.15, 0.1, 0.0099]], [0.01, 0.01])
     s.step(2000)
-    xi_before = s._dev["xi_wall"].to_numpy()[:2].copy()
+    xi_before = s.device.walls.xi.to_numpy()[:2].copy()
     s.add_spheres([[0.1, 0.1, 0.15]], [0.01])  # structural edit: host round trip
     s.step(1)
     s._rebuild_neighbors()
-    xi_after = s._dev["xi_wall"].to_numpy()[:2]
+    xi_after = s.device.walls.xi.to_numpy()[:2]
     np.testing.assert_allclose(xi_after, xi_before, atol=1e-9)
     s.keep_spheres(np.array([True, False, True]))
     assert s.n_particles == 2
@@ -276,7 +277,7 @@ def test_structural_edits_keep_pair_history_and_dynamics():
 
     edited, reference = pile(True), pile(True)
     edited.step(2500)
-    n_pairs_before = edited._dev["n_pairs"]
+    n_pairs_before = edited.device.neighbor_list.n_pairs
     edited.add_spheres([[0.01, 0.14, 0.29]], [0.006])  # another far sphere
     edited.step(1)
     keep = np.ones(edited.n_particles, bool)
