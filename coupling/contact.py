@@ -191,18 +191,18 @@ class WheelContact(Interaction):
             a["cell_start"] = ti.ndarray(ti.i32, shape=self.grid.n_cells + 1)
         origin, inv_cell, dims = self.grid.kernel_args()
         pad = self.r_max + self.skin
-        k.facet_cell_ranges(w["x"], self._tri, self._half_t, sf.n_facets, pad, origin, inv_cell, dims,
+        k.facet_cell_ranges(w.x, self._tri, self._half_t, sf.n_facets, pad, origin, inv_cell, dims,
                             self._lo, self._hi, a["cell_count"])
         total = exclusive_scan(a["cell_count"], a["cell_start"])
         cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
         cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
         k.fill_facet_cells(sf.n_facets, dims, self._lo, self._hi, a["cell_start"], cell_fill, cell_facets)
         k.count_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
-                           w["x"], self._tri, self._half_t, a["count"], a["hist_count"])
+                           w.x, self._tri, self._half_t, a["count"], a["hist_count"])
         n_cand = exclusive_scan(a["count"], a["start"])
         cand = self._buffer("cand", ti.i32, max(n_cand, 1))
         k.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
-                          w["x"], self._tri, self._half_t, a["start"], cand)
+                          w.x, self._tri, self._half_t, a["start"], cand)
         facet_entries = self._buffer("facet_entries", ti.i32, max(n_cand, 1))
         self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, self._facet_start,
                                         self._facet_fill, facet_entries)
@@ -211,7 +211,7 @@ class WheelContact(Interaction):
             self._buffer(name, dtype, max(n_cand, 1))
         self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
         self._arrays["keep"].fill(0)
-        k.copy_node_positions(w["x"], self._nodes, self._node_ref)
+        k.copy_node_positions(w.x, self._nodes, self._node_ref)
         self._seen_rebuilds = scene.neighbor_rebuilds
         self._need_rebuild = False
         self.rebuilds += 1
@@ -248,9 +248,9 @@ class WheelContact(Interaction):
                 (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
                 (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
                  a["f_wheel"], a["m_wheel"], a["xi_new"], a["stiffness"], a["hist_n"], a["hist_xi"], a["hist_count"],
-                 w["x"], w["v"], w["w"], self._inv_mass, self._tri, self._edges, self._half_t,
+                 w.x, w.v, w.w, self._inv_mass, self._tri, self._edges, self._half_t,
                  self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
-                 w["f_ext"], w["k_ext"], w["x_anchor"], self._node_ref, w["hub"], self._resultant),
+                 w.f_ext, w.k_ext, w.x_anchor, self._node_ref, w.hub, self._resultant),
             )
         particles, rest = self._contact_arrays
         k.wheel_contacts_graph(
@@ -326,4 +326,4 @@ class WheelContact(Interaction):
 
     def nodal_forces(self) -> np.ndarray:
         """Contact forces [N] on every structure node at the last evaluation, (N, 3)."""
-        return self.structure.device_arrays()["f_ext"].to_numpy()
+        return self.structure.device_arrays().f_ext.to_numpy()

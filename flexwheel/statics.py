@@ -40,8 +40,8 @@ def residuals(structure: Structure) -> tuple[float, float]:
     f_tot, m_tot = structure.nodal_forces()
     free = np.ones(structure.mesh.n_nodes, bool)
     free[structure.hub_nodes] = False
-    f_ext = structure._dev["f_ext"].to_numpy() + structure.mass[:, None] * structure.gravity
-    m_ext = structure._dev["m_ext"].to_numpy()
+    f_ext = structure.arrays.f_ext.to_numpy() + structure.mass[:, None] * structure.gravity
+    m_ext = structure.arrays.m_ext.to_numpy()
     slot_f, slot_m = structure.element_corner_forces()
     size = structure.mesh.characteristic_length()
     scale_f = max(np.linalg.norm(f_ext[free]), 0.5 * np.linalg.norm(slot_f), 1e-300)
@@ -73,7 +73,7 @@ def relax(
     moment_tolerance = tolerance if moment_tolerance is None else moment_tolerance
     zero = np.zeros((structure.mesh.n_nodes, 3))
     structure.set_state(velocities=zero, angular_velocities=zero)
-    structure._dev["peak"].from_numpy(np.zeros(2))
+    structure.arrays.peak.from_numpy(np.zeros(2))
     steps = 0
     rf = rm = np.inf
     dt = RELAXATION_STEP_FRACTION * structure.critical_time_step

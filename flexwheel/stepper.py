@@ -14,6 +14,9 @@ arguments are set in C++, not in Taichi's Python launch path (~9 us each). The r
 round-off in every form (the serial and parallel loops sum every node's slots in the same order).
 """
 
+from dataclasses import dataclass, fields
+from functools import cached_property
+
 import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
@@ -23,10 +26,63 @@ from . import integrator as itg
 from .beam import beam_element
 from .shell import shell_element
 
-#: The arguments of every stepping kernel after its scalars, in order (the keys of ``Structure._dev``).
-ARRAYS = ("x", "v", "rot", "w", "mass", "inertia", "free", "f_ext", "k_ext", "x_anchor", "m_ext", "slot_start",
-          "slot_list", "slot_f", "slot_m", "f_tot", "m_tot", "tri", "frame0", "local0", "km", "kb", "ends", "bframe0",
-          "blen0", "rigidity", "hub_nodes", "hub_offset", "hub", "hub_rot", "hub_scalar", "peak")
+@dataclass
+class StructureArrays:
+    """The structure's device arrays (Taichi ndarrays), in the order every stepping kernel takes them after its
+    scalars (:meth:`kernel_args`).
+
+    Nodes: x, v, rot, w (position [m], velocity [m/s], rotation, angular velocity [rad/s]); mass [kg], inertia
+    [kg m^2], free (1: integrated; 0: tied to the hub); f_ext, m_ext (held external force [N], moment [N m]);
+    k_ext, x_anchor (the contact's lumped normal stiffness [N/m] and the position it was taken at); f_tot, m_tot
+    (the last step's resultant per node). Element corners: slot_start, slot_list (each node's corner slots),
+    slot_f, slot_m (the corners' forces and moments). Facets: tri, frame0, local0, km, kb (corners, reference
+    frame and local coordinates, membrane and bending stiffness). Beams: ends, bframe0, blen0, rigidity. Hub:
+    hub_nodes, hub_offset, hub (its rows, :data:`.integrator.HUB_ROWS`), hub_rot, hub_scalar. peak: kinetic
+    damping's last energy.
+    """
+
+    x: ti.Ndarray
+    v: ti.Ndarray
+    rot: ti.Ndarray
+    w: ti.Ndarray
+    mass: ti.Ndarray
+    inertia: ti.Ndarray
+    free: ti.Ndarray
+    f_ext: ti.Ndarray
+    k_ext: ti.Ndarray
+    x_anchor: ti.Ndarray
+    m_ext: ti.Ndarray
+    slot_start: ti.Ndarray
+    slot_list: ti.Ndarray
+    slot_f: ti.Ndarray
+    slot_m: ti.Ndarray
+    f_tot: ti.Ndarray
+    m_tot: ti.Ndarray
+    tri: ti.Ndarray
+    frame0: ti.Ndarray
+    local0: ti.Ndarray
+    km: ti.Ndarray
+    kb: ti.Ndarray
+    ends: ti.Ndarray
+    bframe0: ti.Ndarray
+    blen0: ti.Ndarray
+    rigidity: ti.Ndarray
+    hub_nodes: ti.Ndarray
+    hub_offset: ti.Ndarray
+    hub: ti.Ndarray
+    hub_rot: ti.Ndarray
+    hub_scalar: ti.Ndarray
+    peak: ti.Ndarray
+
+    @cached_property
+    def kernel_args(self) -> tuple:
+        """Every array in field order: the stepping kernels' arguments after their scalars (built once: the
+        arrays are written in place, never replaced)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+
+#: The names of :class:`StructureArrays`, in the kernels' argument order.
+ARRAYS = tuple(f.name for f in fields(StructureArrays))
 
 
 @ti.func

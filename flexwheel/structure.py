@@ -223,7 +223,6 @@ class Structure:
         d["f_tot"] = _vec(np.zeros((n, 3)))
         d["m_tot"] = _vec(np.zeros((n, 3)))
         d["peak"] = _nd(ti.f64, np.zeros(2))
-        self._dev = d
 
         # ---- hub
         self.hub_center0 = (
@@ -247,6 +246,7 @@ class Structure:
             d["hub_rot"] = _nd(mat3, np.eye(3)[None])
             d["hub_scalar"] = _nd(ti.f64, np.array([float(hub_mass), 0.0]))
         self.hub_mass_total = float(hub_mass + self.mass[hub].sum())
+        self.arrays = stepper.StructureArrays(**d)
 
         # ---- time step
         if rigid or n_slots == 0:
@@ -274,7 +274,7 @@ class Structure:
                 raise WheelsoilInputError(f"external {name} must have shape ({n}, 3), got {arr.shape}")
             if not np.all(np.isfinite(arr)):
                 raise WheelsoilInputError(f"external {name} contain NaN or inf (first at node {np.argwhere(~np.isfinite(arr))[0][0]})")
-            self._dev[key].from_numpy(arr)
+            getattr(self.arrays, key).from_numpy(arr)
 
     def step(self, n_steps: int = 1, dt: float | None = None, *, kinetic_damping: bool = False) -> None:
         """Advance ``n_steps`` central-difference steps of size ``dt`` (default: the stable step).
@@ -293,12 +293,11 @@ class Structure:
         n_steps = int(n_steps)
         if n_steps <= 0:
             return
-        d = self._dev
         g = self.gravity
         n_facets = 0 if self.rigid else self.n_facets
         n_beams = 0 if self.rigid else self.n_beams
         counts = (self.mesh.n_nodes, n_facets, n_beams, len(self.hub_nodes))
-        arrays = [d[k] for k in stepper.ARRAYS]
+        arrays = self.arrays.kernel_args
         if self.serial:
             for done in range(0, n_steps, self.MAX_STEPS_PER_LAUNCH):
                 stepper.steps_serial(min(self.MAX_STEPS_PER_LAUNCH, n_steps - done), dt, self.damping, *g,
@@ -335,7 +334,7 @@ class Structure:
 
     def state(self) -> dict:
         """Node and hub state, held loads and the clock as NumPy arrays and scalars (for checkpoints)."""
-        out = {k: self._dev[k].to_numpy() for k in self.DYNAMIC_ARRAYS}
+        out = {k: getattr(self.arrays, k).to_numpy() for k in self.DYNAMIC_ARRAYS}
         out.update(time=self.time, steps_taken=self.steps_taken)
         return out
 
@@ -343,14 +342,14 @@ class Structure:
         """Continue from a :meth:`state` of a structure built from the same mesh."""
         for k in self.DYNAMIC_ARRAYS:
             value = np.asarray(state[k])
-            if value.shape != self._dev[k].to_numpy().shape:
+            if value.shape != getattr(self.arrays, k).to_numpy().shape:
                 raise WheelsoilInputError(f"the saved wheel state {k!r} has shape {value.shape}; it belongs to another mesh")
-            self._dev[k].from_numpy(np.ascontiguousarray(value))
+            getattr(self.arrays, k).from_numpy(np.ascontiguousarray(value))
         self.time, self.steps_taken = float(state["time"]), int(state["steps_taken"])
 
     def check_health(self) -> None:
         """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
-        worst = itg.max_speed_squared(self._dev["v"], self._dev["w"])
+        worst = itg.max_speed_squared(self.arrays.v, self.arrays.w)
         limit = 1e3 * self.mesh.material.wave_speed
         if not worst < limit**2:
             raise SimulationUnstableError(
@@ -363,7 +362,7 @@ class Structure:
     def _hub_state(self) -> np.ndarray:
         if not self.hub_nodes.size:
             raise WheelsoilInputError("this structure has no hub")
-        return self._dev["hub"].to_numpy()
+        return self.arrays.hub.to_numpy()
 
     def drive_hub(self, *, velocity=None, angular_velocity=None, free_translation=None, free_rotation=None,
                   force=None, moment=None) -> None:
@@ -386,7 +385,7 @@ class Structure:
         for row, val in ((itg.HUB_FREE_TRANSLATION, free_translation), (itg.HUB_FREE_ROTATION, free_rotation)):
             if val is not None:
                 s[row] = np.asarray(val, bool).reshape(3).astype(float)
-        self._dev["hub"].from_numpy(s)
+        self.arrays.hub.from_numpy(s)
 
     def translate(self, offset) -> None:
         """Move the whole structure rigidly by ``offset`` [m] (nodes, the anchors of held contact forces and the
@@ -395,11 +394,11 @@ class Structure:
         if not np.all(np.isfinite(off)):
             raise WheelsoilInputError(f"translation {off.tolist()} must be finite")
         for key in ("x", "x_anchor"):
-            self._dev[key].from_numpy(self._dev[key].to_numpy() + off)
+            getattr(self.arrays, key).from_numpy(getattr(self.arrays, key).to_numpy() + off)
         if self.hub_nodes.size:
             s = self._hub_state()
             s[itg.HUB_POSITION] += off
-            self._dev["hub"].from_numpy(s)
+            self.arrays.hub.from_numpy(s)
         self.hub_center0 = self.hub_center0 + off
 
     def set_hub_state(self, *, velocity=None, angular_velocity=None) -> None:
@@ -409,7 +408,7 @@ class Structure:
             s[itg.HUB_VELOCITY] = np.asarray(velocity, float).reshape(3)
         if angular_velocity is not None:
             s[itg.HUB_SPIN] = np.asarray(angular_velocity, float).reshape(3)
-        self._dev["hub"].from_numpy(s)
+        self.arrays.hub.from_numpy(s)
 
     @property
     def hub_position(self) -> np.ndarray:
@@ -426,26 +425,27 @@ class Structure:
     @property
     def hub_rotation(self) -> np.ndarray:
         self._hub_state()
-        return self._dev["hub_rot"].to_numpy()[0]
+        return self.arrays.hub_rot.to_numpy()[0]
 
     def hub_reaction(self, reset: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Mean force [N] and moment about the hub centre [N m] the rig applied to the prescribed hub
         dofs since the last reset (zero on free dofs)."""
         s = self._hub_state()
-        scal = self._dev["hub_scalar"].to_numpy()
+        scal = self.arrays.hub_scalar.to_numpy()
         k = max(scal[itg.HUB_SAMPLES], 1.0)
         f, m = s[itg.HUB_REACTION_FORCE] / k, s[itg.HUB_REACTION_MOMENT] / k
         if reset:
             s[itg.HUB_REACTION_FORCE] = 0.0
             s[itg.HUB_REACTION_MOMENT] = 0.0
             scal[itg.HUB_SAMPLES] = 0.0
-            self._dev["hub"].from_numpy(s)
-            self._dev["hub_scalar"].from_numpy(scal)
+            self.arrays.hub.from_numpy(s)
+            self.arrays.hub_scalar.from_numpy(scal)
         return f, m
 
     # ------------------------------------------------------------------ state out
-    def device_arrays(self) -> dict:
-        """The Taichi ndarrays a coupling reads and writes (valid for the structure's lifetime).
+    def device_arrays(self) -> stepper.StructureArrays:
+        """The Taichi ndarrays (:class:`~.stepper.StructureArrays`, valid for the structure's lifetime). What a
+        coupling reads and writes:
 
         ``x``, ``v``, ``w``: node positions [m], velocities [m/s] and spins [rad/s]; ``f_ext``,
         ``m_ext``: external nodal forces [N] and moments [N m], held over :meth:`advance` (a coupling
@@ -454,29 +454,29 @@ class Structure:
         f_ext - k_ext (x - x_anchor)); ``mass``: lumped node masses [kg]; ``hub``: the hub state rows
         (``flexwheel.integrator.HUB_*``; row 0 is the hub centre).
         """
-        return {k: self._dev[k] for k in ("x", "v", "w", "f_ext", "m_ext", "k_ext", "x_anchor", "mass", "hub")}
+        return self.arrays
 
     def positions(self) -> np.ndarray:
         """Node positions (N, 3) [m]."""
-        return self._dev["x"].to_numpy()
+        return self.arrays.x.to_numpy()
 
     def velocities(self) -> np.ndarray:
         """Node velocities (N, 3) [m/s] (at the last half step)."""
-        return self._dev["v"].to_numpy()
+        return self.arrays.v.to_numpy()
 
     def angular_velocities(self) -> np.ndarray:
-        return self._dev["w"].to_numpy()
+        return self.arrays.w.to_numpy()
 
     def rotations(self) -> np.ndarray:
         """Node rotation matrices (N, 3, 3) from the reference configuration."""
-        return self._dev["rot"].to_numpy()
+        return self.arrays.rot.to_numpy()
 
     def displacements(self) -> np.ndarray:
         return self.positions() - self.mesh.nodes
 
     def nodal_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """Total force and moment on every node at the last step (elastic + external + gravity)."""
-        return self._dev["f_tot"].to_numpy(), self._dev["m_tot"].to_numpy()
+        return self.arrays.f_tot.to_numpy(), self.arrays.m_tot.to_numpy()
 
     @property
     def surface_triangles(self) -> np.ndarray:
@@ -491,24 +491,24 @@ class Structure:
                 arr = np.asarray(val, float)
                 if arr.shape != (self.mesh.n_nodes,) + shape or not np.all(np.isfinite(arr)):
                     raise WheelsoilInputError(f"{key} must be a finite array of shape {(self.mesh.n_nodes,) + shape}")
-                self._dev[key].from_numpy(arr)
+                getattr(self.arrays, key).from_numpy(arr)
 
     def _launch_element_forces(self) -> None:
         """Evaluate every element's corner forces and moments into the slot arrays (parallel kernels)."""
         if self.rigid:
             return
-        d = self._dev
+        d = self.arrays
         if self.n_facets:
-            shell_forces(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"], d["slot_f"], d["slot_m"], 0)
+            shell_forces(d.x, d.rot, d.tri, d.frame0, d.local0, d.km, d.kb, d.slot_f, d.slot_m, 0)
         if self.n_beams:
-            beam_forces(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"], d["slot_f"],
-                        d["slot_m"], self._slot_beam_base)
+            beam_forces(d.x, d.rot, d.ends, d.bframe0, d.blen0, d.rigidity, d.slot_f,
+                        d.slot_m, self._slot_beam_base)
 
     def element_corner_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """Elastic force and moment on each element corner of the current state (facet corners, then
         beam ends; zero for a rigid structure). No step is taken."""
         self._launch_element_forces()
-        return self._dev["slot_f"].to_numpy(), self._dev["slot_m"].to_numpy()
+        return self.arrays.slot_f.to_numpy(), self.arrays.slot_m.to_numpy()
 
     def internal_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """Elastic nodal forces and moments (N, 3) of the current state (no step is taken)."""
@@ -526,19 +526,19 @@ class Structure:
         """Elastic energy stored in the elements [J]."""
         if self.rigid:
             return 0.0
-        d = self._dev
+        d = self.arrays
         total = 0.0
         if self.n_facets:
             e = ti.ndarray(ti.f64, shape=self.n_facets)
-            shell_energies(d["x"], d["rot"], d["tri"], d["frame0"], d["local0"], d["km"], d["kb"], d["slot_f"], d["slot_m"], e)
+            shell_energies(d.x, d.rot, d.tri, d.frame0, d.local0, d.km, d.kb, d.slot_f, d.slot_m, e)
             total += float(e.to_numpy().sum())
         if self.n_beams:
             e = ti.ndarray(ti.f64, shape=self.n_beams)
-            beam_energies(d["x"], d["rot"], d["ends"], d["bframe0"], d["blen0"], d["rigidity"], d["slot_f"], d["slot_m"], e)
+            beam_energies(d.x, d.rot, d.ends, d.bframe0, d.blen0, d.rigidity, d.slot_f, d.slot_m, e)
             total += float(e.to_numpy().sum())
         return total
 
     def kinetic_energy(self) -> float:
         """1/2 sum m v^2 + 1/2 sum I omega^2 over the nodes [J] (half-step velocities)."""
-        d = self._dev
-        return float(itg.kinetic_energy(self.mesh.n_nodes, d["v"], d["w"], d["mass"], d["inertia"]))
+        d = self.arrays
+        return float(itg.kinetic_energy(self.mesh.n_nodes, d.v, d.w, d.mass, d.inertia))

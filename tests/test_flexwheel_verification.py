@@ -280,9 +280,9 @@ def test_assembled_critical_step_is_the_stability_limit():
         assert s.critical_time_step == pytest.approx(2.0 / omega, rel=1e-12)
         s.set_state(velocities=v0, angular_velocities=w0)
         e0 = s.kinetic_energy()
-        d = s._dev  # the kernels directly: Structure.step refuses a step above the limit
+        # the kernels directly: Structure.step refuses a step above the limit
         stepper.steps_serial(4000, fraction * 2.0 / omega, 0.0, 0.0, 0.0, 0.0, 0, mesh.n_nodes, len(mesh.triangles),
-                             len(mesh.beams), 0, *[d[k] for k in stepper.ARRAYS])
+                             len(mesh.beams), 0, *s.arrays.kernel_args)
         growth[fraction] = s.kinetic_energy() / e0
     assert growth[0.98] < 10.0
     assert not growth[1.03] < 1e6
