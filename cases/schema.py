@@ -1,7 +1,9 @@
 """The case file: a TOML description of one testbed run, validated by a pydantic schema.
 
-A case has six sections; every key has a default (the smoke steering run), so a case file holds
-only what differs from it. ``wheelsoil case show`` prints every key with its unit, range and default.
+A case has six sections; every key has a default (the smoke steering run, :mod:`wheelsoil.parameters.smoke`), so
+a case file holds only what differs from it. Each key's allowed range is the solver spec's own (``RANGES`` of
+``TestbedSpec``, ``BedSpec``, ``WheelGeometry``, ``Material``, ``PairProperties``); :mod:`.build` turns a case into
+those specs. ``wheelsoil case show`` prints every key with its unit, range and default.
 
     [case]      name, description, seed of the bed's random packing
     [soil]      bin size, particle sizes, gravity, particle material and soil--soil friction

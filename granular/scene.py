@@ -11,7 +11,11 @@ Example
 >>> scene.positions.shape
 (1, 3)
 
-State lives in Taichi arrays while the scene steps; the properties below return NumPy copies.
+State lives in Taichi arrays while the scene steps; the properties below return NumPy copies. The scene is the
+facade over its parts on the device (:attr:`Scene.device`): the particle arrays (:mod:`.particles`), the walls
+(:mod:`.walls`), the neighbour list with the pairs' contact history on the shared grid (:mod:`.neighbor_list`,
+:mod:`.grid`), the pair constants (:class:`.contact.ContactParameters`) and the stepper (:mod:`.stepper`); it keeps
+the host mirror, the structural edits (spheres, walls, holds, histories), the clock and the health checks.
 """
 
 from __future__ import annotations

@@ -27,10 +27,10 @@ def measured_dir():
     return path
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def bed_cache(tmp_path_factory):
-    """A fresh bed cache for the module's runs, also seen by the ``wheelsoil`` processes they start
-    (``WHEELSOIL_CACHE``); the variable is restored afterwards."""
+    """A fresh bed cache for the session's runs (a bed is prepared once for every test that asks for it), also
+    seen by the ``wheelsoil`` processes they start (``WHEELSOIL_CACHE``); the variable is restored afterwards."""
     path = tmp_path_factory.mktemp("bed-cache")
     old = os.environ.get("WHEELSOIL_CACHE")
     os.environ["WHEELSOIL_CACHE"] = str(path)

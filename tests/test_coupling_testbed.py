@@ -24,8 +24,8 @@ MINI_RUN = TestbedSpec(slip=0.3, slip_angle=10.0, load=80.0, angular_velocity=2.
 
 
 @pytest.fixture(scope="module")
-def mini_bed(tmp_path_factory):
-    return prepare_bed(MINI_BED, cache_dir=tmp_path_factory.mktemp("beds"))
+def mini_bed(bed_cache):
+    return prepare_bed(MINI_BED, cache_dir=bed_cache)
 
 
 @pytest.fixture(scope="module")

@@ -124,3 +124,11 @@ def test_a_range_names_the_key_the_value_and_the_bounds():
         TestbedSpec(slip=True)
     assert Range(0.0, 1.0).contains(0.0) and not Range(0.0, 1.0, lo_open=True).contains(0.0)
     assert Range(0.0, 1.0, infinite=True).contains(math.inf) and not Range(0.0, 1.0).contains(math.inf)
+
+
+def test_the_readme_s_python_example_builds_the_three_specs():
+    from wheelsoil.cases import load_case, specs
+
+    bed, wheel, test = specs(load_case("smoke-moon-steer", ["test.slip=0.4"]))
+    assert isinstance(bed, BedSpec) and isinstance(wheel, WheelGeometry) and isinstance(test, TestbedSpec)
+    assert test.slip == 0.4 and bed.gravity[2] == pytest.approx(-9.81 / 6) and wheel.name == "lunar-rover"
