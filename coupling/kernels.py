@@ -3,9 +3,10 @@
 Two kinds of work:
 
 * *Rebuild* (when particles or the wheel have moved far enough): bin the contact facets into the
-  scene's uniform grid (:mod:`wheelsoil.granular.grid`, the cells the soil's neighbour search uses), list for every particle the facets within its reach plus a skin (its *candidates*,
-  sorted by facet so that results do not depend on thread scheduling), compact the particles that
-  have candidates into an *active* list, and transpose the candidate list per facet.
+  scene's uniform grid (:mod:`wheelsoil.granular.grid`, the cells the soil's neighbour search uses),
+  list for every particle the facets within its reach plus a skin (its *candidates*, sorted by facet
+  so that results do not depend on thread scheduling), compact the particles that have candidates
+  into an *active* list, and transpose the candidate list per facet.
 * *Every step* (:func:`wheel_contacts`, one launch), in phases, each a Taichi function:
   (A) :func:`candidate_geometry` -- per active particle, classify each candidate by the Voronoi region of
   its closest point (face, edge, vertex); (B) :func:`counted_once` -- keep each physical contact once;

@@ -81,9 +81,6 @@ class StructureArrays:
         return tuple(getattr(self, f.name) for f in fields(self))
 
 
-#: The names of :class:`StructureArrays`, in the kernels' argument order.
-ARRAYS = tuple(f.name for f in fields(StructureArrays))
-
 
 @ti.func
 def _kinetic_restart(n_nodes, v: ti.template(), w: ti.template(), mass: ti.template(), inertia: ti.template(),
@@ -134,7 +131,7 @@ def _steps_serial(
 
 
 #: The serial stepping kernel as a compute graph: (n_steps, dt, damping, gx, gy, gz, kinetic, n_nodes,
-#: n_facets, n_beams, n_hub, *arrays in :data:`ARRAYS` order).
+#: n_facets, n_beams, n_hub, *StructureArrays.kernel_args).
 steps_serial = GraphKernel(_steps_serial)
 
 _PARALLEL: dict = {}
@@ -142,7 +139,7 @@ _PARALLEL: dict = {}
 
 def steps_parallel(n_steps: int) -> GraphKernel:
     """The parallel stepping kernel for exactly ``n_steps`` steps (compiled once per count), as a compute graph
-    taking (dt, damping, gx, gy, gz, kinetic, n_nodes, n_facets, n_beams, n_hub, *arrays in :data:`ARRAYS` order).
+    taking (dt, damping, gx, gy, gz, kinetic, n_nodes, n_facets, n_beams, n_hub, *StructureArrays.kernel_args).
     """
     n_steps = int(n_steps)
     if n_steps in _PARALLEL:
