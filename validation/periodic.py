@@ -287,8 +287,9 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
 
     results: finished runs as read by the caller (``wheelsoil.cases.results.load_result``): each with ``wheel``
     (its :class:`~wheelsoil.flexwheel.geometry.WheelGeometry`), ``case`` (its case file: ``wheel.rigid``,
-    ``soil.gravity_vector``, ``test``), ``info`` and ``series``, as :func:`runs_from_results` reads them; source: what they are, for titles and errors (e.g. the
-    sweep folder). Validation reads results through this interface and does not import the case layer."""
+    ``soil.gravity_vector``, ``test``), ``info`` and ``series``, as :func:`runs_from_results` reads them;
+    source: what they are, for titles and errors (e.g. the sweep folder). Validation reads results through this
+    interface and does not import the case layer."""
     results = list(results)
     if not results:
         raise WheelsoilInputError(f"{source} holds no finished runs; run 'wheelsoil batch' first")
