@@ -160,14 +160,8 @@ class WheelContact(Interaction):
         self.wheel_skin = self._wheel_skin_request or 4.0 * scene.skin
         self.skin = scene.skin + self.wheel_skin  # candidate margin
         self.r_max = float(radii.max())
-        # the soil's own grid: a facet is binned into every cell its box grown by r_max + skin meets, and a
-        # sphere reads only its cell, so any cell edge works
-        self.grid = scene.grid
-        n_cells = self.grid.n_cells
         a = self._arrays
         a.clear()
-        a["cell_count"] = ti.ndarray(ti.i32, shape=n_cells)
-        a["cell_start"] = ti.ndarray(ti.i32, shape=n_cells + 1)
         a["count"] = ti.ndarray(ti.i32, shape=n)
         a["start"] = ti.ndarray(ti.i32, shape=n + 1)
         a["active"] = ti.ndarray(ti.i32, shape=n)
@@ -185,11 +179,13 @@ class WheelContact(Interaction):
         w = self.structure.device_arrays()
         a = self._arrays
         sf = self.surface
-        self.grid = scene.grid  # the scene may have rebuilt its device state (same cells unless its spheres changed)
-        if self.grid.n_cells != a["cell_count"].shape[0]:
-            a["cell_count"] = ti.ndarray(ti.i32, shape=self.grid.n_cells)
-            a["cell_start"] = ti.ndarray(ti.i32, shape=self.grid.n_cells + 1)
-        origin, inv_cell, dims = self.grid.kernel_args()
+        # the soil's own grid (:meth:`Scene.grid`): a facet is binned into every cell its box grown by r_max + skin
+        # meets, and a sphere reads only its cell, so any cell edge works
+        grid = scene.grid
+        if "cell_count" not in a or a["cell_count"].shape[0] != grid.n_cells:
+            a["cell_count"] = ti.ndarray(ti.i32, shape=grid.n_cells)
+            a["cell_start"] = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
+        origin, inv_cell, dims = grid.kernel_args()
         pad = self.r_max + self.skin
         k.facet_cell_ranges(w.x, self._tri, self._half_t, sf.n_facets, pad, origin, inv_cell, dims,
                             self._lo, self._hi, a["cell_count"])

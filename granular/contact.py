@@ -53,8 +53,7 @@ class ContactParameters:
     """The sphere--sphere pair constants of one soil, computed once from its material and pair properties.
 
     e_eff, g_eff: E* and G* of two spheres of the material [Pa] (eqs. 10, 12); beta: the damping ratio of the
-    restitution (eq. 9); mu_s, mu_r: sliding and rolling friction; period, inv_period: the length [m] of a
-    domain periodic along x and its inverse (both 0 otherwise: nearest-image distances switched off).
+    restitution (eq. 9); mu_s, mu_r: sliding and rolling friction.
     """
 
     e_eff: float
@@ -62,14 +61,11 @@ class ContactParameters:
     beta: float
     mu_s: float
     mu_r: float
-    period: float = 0.0
-    inv_period: float = 0.0
 
     @classmethod
-    def of(cls, material: Material, pair: PairProperties, period: float = 0.0) -> "ContactParameters":
+    def of(cls, material: Material, pair: PairProperties) -> "ContactParameters":
         return cls(effective_modulus(material, material), effective_shear_modulus(material, material),
-                   pair.damping_ratio, pair.static_friction, pair.rolling_friction, float(period),
-                   1.0 / period if period > 0 else 0.0)
+                   pair.damping_ratio, pair.static_friction, pair.rolling_friction)
 
 
 @ti.func

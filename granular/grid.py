@@ -23,11 +23,13 @@ MAX_CELLS = 2**31 - 2
 
 @dataclass(frozen=True)
 class UniformGrid:
-    """Cubic cells of edge ``cell`` [m] from ``origin`` [m], ``dims`` cells along x, y, z."""
+    """Cubic cells of edge ``cell`` [m] from ``origin`` [m], ``dims`` cells along x, y, z; ``period`` [m] > 0: the
+    domain is periodic along x with that length (0: not periodic)."""
 
     origin: tuple[float, float, float]
     cell: float
     dims: tuple[int, int, int]
+    period: float = 0.0
 
     @classmethod
     def covering(cls, lo, hi, cell: float, *, period: float = 0.0) -> "UniformGrid":
@@ -49,11 +51,16 @@ class UniformGrid:
             dims[0] = along
         if int(np.prod(dims)) > MAX_CELLS:
             raise WheelsoilInputError(f"neighbour grid of {dims.tolist()} cells is too large; raise cell_size")
-        return cls(tuple(float(v) for v in lo), cell, tuple(int(v) for v in dims))
+        return cls(tuple(float(v) for v in lo), cell, tuple(int(v) for v in dims), float(period))
 
     @property
     def inv_cell(self) -> float:
         return 1.0 / self.cell
+
+    @property
+    def inv_period(self) -> float:
+        """1 / period (0 when not periodic: the kernels' nearest-image distances are then the plain ones)."""
+        return 1.0 / self.period if self.period > 0 else 0.0
 
     @property
     def n_cells(self) -> int:

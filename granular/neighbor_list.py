@@ -75,16 +75,14 @@ def row_width(r_min: float, r_max: float, skin: float) -> int:
 
 
 class NeighborList:
-    """Cells, rows and the pair list of ``n`` spheres on ``grid`` with Verlet ``skin`` [m] (``period`` [m] > 0: the
-    domain is periodic along x); ``pairs`` holds the history the first build carries over."""
+    """Cells, rows and the pair list of ``n`` spheres on ``grid`` (periodic along x where the grid is) with Verlet
+    ``skin`` [m]; ``pairs`` holds the history the first build carries over."""
 
     #: Widest row allowed: more partners with higher indices than this means an unreasonable size ratio or skin.
     MAX_ROW = 4096
 
-    def __init__(self, n: int, grid: UniformGrid, skin: float, width: int, pairs: PairList, *,
-                 period: float = 0.0) -> None:
-        self.n, self.grid, self.skin, self.period = n, grid, float(skin), float(period)
-        self.inv_period = 1.0 / self.period if self.period > 0 else 0.0
+    def __init__(self, n: int, grid: UniformGrid, skin: float, width: int, pairs: PairList) -> None:
+        self.n, self.grid, self.skin = n, grid, float(skin)
         self.cell_of = ti.ndarray(ti.i32, shape=n)
         self.cell_count = ti.ndarray(ti.i32, shape=grid.n_cells)
         self.cell_start = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
@@ -107,8 +105,8 @@ class NeighborList:
         """Rebin the spheres, rebuild the rows and the pair list (history carried over), list the walls in reach,
         and take the positions as the new Verlet reference."""
         grid = self.grid
-        if self.period > 0.0:
-            neighbors.wrap_positions(p.x, p.x_r, grid.origin[0], self.period)
+        if grid.period > 0.0:
+            neighbors.wrap_positions(p.x, p.x_r, grid.origin[0], grid.period)
         origin, inv_cell, dims = grid.kernel_args()
         neighbors.bin_particles(p.x, origin, inv_cell, dims, self.cell_of, self.cell_count)
         neighbors.exclusive_scan(self.cell_count, self.cell_start)
@@ -117,7 +115,7 @@ class NeighborList:
         def build_rows() -> int:
             return neighbors.build_neighbor_lists(
                 p.x, p.r, self.cell_start, self.sorted_ids, origin, inv_cell, dims, self.skin,
-                self.period, self.inv_period, self.nbr, self.count,
+                grid.period, grid.inv_period, self.nbr, self.count,
             )
 
         most = build_rows()

@@ -617,9 +617,9 @@ class Scene:
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = (PairList.from_history(n, h["pair_i"], h["pair_j"], h["pair_xi"]) if h is not None
                  else PairList.allocate(n, 1))
-        neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs, period=self.period)
+        neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs)
         walls = WallArrays.upload(self.walls, self.material, n, h["xi_wall"] if h is not None else None)
-        params = ContactParameters.of(self.material, self.pair, self.period)
+        params = ContactParameters.of(self.material, self.pair)
         self._device = DeviceParts(particles, neighbor_list, walls, params,
                                    Stepper(particles, neighbor_list, walls, params), ti.ndarray(ti.f64, shape=4))
         self._rebuild_neighbors()

@@ -53,20 +53,19 @@ class Stepper:
     def fused(self, gravity, dt: float, *, external: bool, drift: bool) -> tuple[int, float]:
         """Force pass and closing half kick, then (``drift``) the next step's opening kick and drift, in one launch;
         returns the contacts and the largest squared displacement since the last rebuild [m^2]."""
-        p, c = self.particles, self.params
-        pair_args = self._pair_args()
+        p, grid = self.particles, self.neighbor_list.grid
         fused_step.contact_step_graph(
-            p.x, p.v, p.w, p.r, p.m, p.I, p.mobile, *pair_args[:13], *pair_args[13:], dt,
-            c.period, c.inv_period, int(external), p.f_ext, p.t_ext, p.f, p.t,
+            p.x, p.v, p.w, p.r, p.m, p.I, p.mobile, *self._pair_args(), dt,
+            grid.period, grid.inv_period, int(external), p.f_ext, p.t_ext, p.f, p.t,
             *gravity, int(drift), p.x_ref, p.x_r, p.v_m, p.w_i, self.result,
         )
         return int(self.result[0]), float(self.result[1])
 
     def forces_and_kick(self, gravity, dt: float, *, external: bool) -> int:
         """Force pass, then the closing half kick (two launches); returns the contacts."""
-        p, c = self.particles, self.params
+        p, grid = self.particles, self.neighbor_list.grid
         forces.contact_forces_graph(
-            p.x_r, p.v_m, p.w_i, *self._pair_args(), dt, c.period, c.inv_period, int(external),
+            p.x_r, p.v_m, p.w_i, *self._pair_args(), dt, grid.period, grid.inv_period, int(external),
             p.f_ext, p.t_ext, p.f, p.t, self.result,
         )
         integrator.kick_graph(p.v, p.w, p.f, p.t, p.m, p.I, p.mobile, *gravity, dt)
