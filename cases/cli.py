@@ -50,6 +50,12 @@ hold the semi-empirical model against measured data and name what it misses:
 
     wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --holdout slip_angle=60
 
+fit on one dataset, predict another, or hold each steering angle out in turn:
+
+    wheelsoil validate smooth_wheel_trials.csv --test grouser_wheel_trials.csv --report runs/s2g
+    wheelsoil predict runs/s2g/model.json grouser_wheel_trials.csv --out runs/s2g-predict
+    wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --cv slip_angle --report runs/cv
+
 or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
     wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --dmin 0.016 --dmax 0.024 --gravity moon \
@@ -291,11 +297,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("validate", help="hold the semi-empirical model against measured data; name what it misses",
                        description="Calibrate the classical wheel-soil model (Wong-Reece, Janosi-Hanamoto, lateral "
-                                   "shear) on training conditions, diagnose its residuals, fit every candidate "
-                                   "mechanism the data can show (slip-sinkage, theta_m moving with slip, soil flow, "
-                                   "sidewall, grousers, surrogate radius, gravity-scaled cohesion, bulldozing), rank them by "
-                                   "held-out error and BIC, and write report.md, findings.json and plots to "
-                                   "--report. DATA: a folder of CMU trial files, the digitised single-wheel CSV, a "
+                                   "shear; every soil parameter the data can inform free, unidentified and at-bound "
+                                   "ones flagged) on training conditions, diagnose its residuals, then select "
+                                   "mechanisms forward (slip-sinkage, theta_m moving with slip, soil flow, sidewall, "
+                                   "grousers, grouser tips, surrogate radius, gravity acting through cohesion, pressure "
+                                   "or soil flow, bulldozing, multipass): each step refits the model with every "
+                                   "remaining candidate and accepts the one that lowers BIC by 10, gains on held-out "
+                                   "data, has a physical parameter and removes most of the systematic residual; "
+                                   "ambiguities and unexplained trends are reported. Writes report.md, findings.json, "
+                                   "model.json (for 'wheelsoil predict') and plots to --report. DATA: a folder of CMU trial files, the digitised single-wheel CSV, a "
                                    "CSV in wheelsoil's format (slip, vertical_load_N, wheel_radius_m, "
                                    "wheel_width_m, drawbar_pull_N, ...), a wheelsoil sweep folder (the DEM-FEM "
                                    "runs of 'wheelsoil batch' as data: what the classical model misses of the "
@@ -324,8 +334,41 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--group", default=None,
                    help="keep the rows whose group starts with this (e.g. ding2011: one rig and soil of the "
                         "digitised set; grouser or smooth in the CMU set)")
+    p.add_argument("--test", default=None, metavar="TEST",
+                   help="a second dataset (any supported format): fit on DATA, then predict TEST with the fitted "
+                        "model and report its errors there (normalised by DATA's spread)")
+    p.add_argument("--cv", default=None, metavar="CONDITION",
+                   help="leave-one-condition-out cross-validation instead of one hold-out: each level of CONDITION "
+                        "(slip_angle, load, gravity, slip, passes, grouser_height, group) held out in turn; writes "
+                        "crossval.md and crossval.json to --report")
     p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser("predict", help="predict measured conditions with a model saved by 'wheelsoil validate'",
+                       description="Rebuild the calibrated model from MODEL (the model.json that 'wheelsoil validate' "
+                                   "writes beside its report) and predict every row of DATA: writes "
+                                   "predictions.csv (measured, classical and final model per response) to --out and "
+                                   "prints the errors.")
+    p.add_argument("model", help="model.json written by 'wheelsoil validate'")
+    p.add_argument("data", help="measured data (folder or CSV, any format 'wheelsoil validate' reads)")
+    p.add_argument("--out", type=Path, default=Path("wheelsoil-output/predict"), help="output folder")
+    p.add_argument("--group", default=None, help="keep the rows whose group starts with this")
+    p.set_defaults(func=cmd_predict)
     return parser
+
+
+def cmd_predict(args) -> int:
+    from wheelsoil.provenance import writable_folder
+    from wheelsoil.validation.workflow import predict_command
+
+    writable_folder(args.out, "--out")
+    out = predict_command(args.model, args.data, out=args.out, group=args.group)
+    console = _console()
+    console.print(f"model: classical + {' + '.join(out['mechanisms']) or 'nothing'}; {out['rows']} rows")
+    for q, e in out["errors"].items():
+        console.print(f"  {q:14s} RMSE classical {e['baseline']['rmse']:.4g}, model {e['final']['rmse']:.4g} "
+                      f"(normalised {e['baseline']['nrmse']:.3f} -> {e['final']['nrmse']:.3f}; {e['rows']} rows)")
+    console.print(f"wrote {out['predictions']}")
+    return EXIT_OK
 
 
 def cmd_validate(args) -> int:

@@ -1,6 +1,8 @@
-"""Hidden-effect tests: synthetic measurements from the classical model plus one mechanism the workflow is
-not told about (magnitude drawn at random, realistic noise); it must name the mechanism, recover it, and
-show a positive held-out gain -- and find nothing when nothing is hidden."""
+"""Hidden-effect tests: synthetic measurements from the classical model plus mechanisms the workflow is not told
+about (magnitudes drawn at random, realistic noise); it must name each hidden mechanism, recover it, and show a
+positive held-out gain; name both of a hidden pair; find nothing when nothing is hidden; and report an effect the
+catalogue does not hold as unexplained rather than give it a catalogue name. Rates over many draws are measured by
+the campaigns in docs/validation/campaigns.md; these tests cover a few seeds each, fixed in advance."""
 
 from dataclasses import replace
 
@@ -12,9 +14,11 @@ from wheelsoil.validation.discovery import discover, holdout_mask, mechanism_eff
 from wheelsoil.validation.extensions import EXTENSIONS
 from wheelsoil.validation.synthetic import (
     HIDDEN_RANGES,
+    OUT_OF_CATALOGUE,
     TRUE_SOIL,
     conditions,
     draw_hidden_effect,
+    draw_out_of_catalogue,
     synthetic_measurements,
 )
 
@@ -35,7 +39,8 @@ DEFAULT_EFFECT_TOLERANCE = 0.3
 #: do not change when one is added).
 DRAW_SEEDS = {name: 100 + k for k, name in enumerate(
     ["gravity_cohesion", "grouser", "sidewall", "slip_sinkage", "soil_flow", "surrogate_radius", "theta_m_slip",
-     "bulldozing", "multipass"])}
+     "bulldozing", "multipass", "gravity_pressure", "gravity_soil_flow"])}
+DIRECT_TOLERANCE.update({"kphi_gravity_exponent": 0.15, "soil_flow_gravity": 0.08})
 
 
 def test_every_hidden_mechanism_has_a_draw_seed():
@@ -49,9 +54,8 @@ def test_hidden_mechanism_is_named_recovered_and_gains_on_heldout_data(mechanism
     name, hidden = draw_hidden_effect(rng, [mechanism])
     data = synthetic_measurements(hidden, rng)
     d = discover(data, seed=1)
-    found = d.found
-    assert found is not None, f"nothing found; hidden {name} {hidden}"
-    assert found.extension.name == name, (found.extension.name, name, hidden)
+    assert d.found == [name], (d.found, name, hidden)
+    found = d.accepted[0]
     (param, true), = hidden.items()
     if param in DIRECT_TOLERANCE:
         assert found.fit.free[param] == pytest.approx(true, abs=DIRECT_TOLERANCE[param])
@@ -70,29 +74,83 @@ def test_grouser_tip_radius_is_named_in_a_two_wheel_set():
     rng = np.random.default_rng(200)
     hidden = {k: float(rng.uniform(*b)) for k, b in TWO_WHEEL_HIDDEN_RANGES["grouser_tip_radius"].items()}
     d = discover(synthetic_two_wheel_measurements(hidden, rng), seed=1)
-    assert d.found is not None and d.found.extension.name == "grouser_tip_radius", hidden
-    assert d.found.fit.free["grouser_tip_fraction"] == pytest.approx(hidden["grouser_tip_fraction"], abs=0.25)
-    assert d.found.gain > 0 and d.found.delta_bic < -10
+    assert d.found == ["grouser_tip_radius"], hidden
+    found = d.accepted[0]
+    assert found.fit.free["grouser_tip_fraction"] == pytest.approx(hidden["grouser_tip_fraction"], abs=0.25)
+    assert found.gain > 0 and found.delta_bic < -10
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [7, 8])
+@pytest.mark.parametrize("seed", [7, 8, 9])
 def test_nothing_is_found_where_nothing_is_hidden(seed):
+    """Null data from the package's own generator (its truth inside the calibrated space), noise drawn with
+    a heteroscedastic part: nothing named, nothing partial, no unexplained trend."""
     rng = np.random.default_rng(seed)
-    data = synthetic_measurements({}, rng)
+    data = synthetic_measurements({}, rng, noise=rng.uniform(0.01, 0.05), relative_noise=rng.uniform(0.0, 0.04))
     d = discover(data, seed=seed)
-    assert d.found is None, d.found.to_dict()
+    assert d.accepted == [], [c.to_dict() for c in d.accepted]
+    assert d.unexplained == [] and d.ambiguities == []
     # the classical model then fits to the noise level on held-out conditions
     assert d.baseline_heldout_rmse < 0.15
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [31, 32, 33])
+def test_a_hidden_pair_is_named_or_reported_ambiguous_never_misnamed(seed):
+    """Two mechanisms hidden together (drawn by the seed): no wrong name, at least one of the two named, and each
+    named or inside a reported ambiguity (two candidates the data cannot tell apart). How often both are named
+    outright is a rate (goal >= 80 %), measured by the pair campaign in docs/validation/campaigns.md."""
+    rng = np.random.default_rng(seed)
+    names = list(HIDDEN_RANGES)
+    pair = [names[j] for j in rng.choice(len(names), 2, replace=False)]
+    hidden = {}
+    for name in pair:
+        hidden.update(draw_hidden_effect(rng, [name])[1])
+    d = discover(synthetic_measurements(hidden, rng), seed=seed)
+    ambiguous = {n for group in d.ambiguities for n in group}
+    assert set(d.found) <= set(pair), (d.found, pair, hidden)
+    assert d.found and all(n in d.found or n in ambiguous for n in pair), (d.found, pair, d.ambiguities, hidden)
+
+
+@pytest.mark.slow
+def test_effects_outside_the_catalogue_rarely_get_a_catalogue_name():
+    """One draw of each effect of forms the catalogue does not hold (a gravity effect through the friction angle,
+    a load-dependent shear modulus or density, strain-softening cohesion, friction falling with the slip angle),
+    seeds fixed in advance. A wrong name is a rate, not an impossibility (goal <= 5 %; the ooc campaign in
+    docs/validation/campaigns.md measures it): at that rate two or more wrong names in five draws happen with a
+    probability under 3 %, so at most one is allowed here. The misfit must be reported (unexplained, partial or
+    ambiguous) in at least three of the five."""
+    wrong, reported = [], 0
+    for k, effect in enumerate(sorted(OUT_OF_CATALOGUE)):
+        rng = np.random.default_rng(40 + k)
+        name, strength = draw_out_of_catalogue(rng, [effect])
+        d = discover(synthetic_measurements({}, rng, effect=(name, strength)), seed=3)
+        if d.found:
+            wrong.append((effect, round(strength, 3), d.found))
+        reported += bool(d.unexplained or d.partial or d.ambiguities)
+    assert len(wrong) <= 1, wrong
+    assert reported >= 3, reported
 
 
 def test_mechanisms_the_data_cannot_show_are_not_tried():
     rng = np.random.default_rng(3)
     cond = conditions(slip_angles=(0.0,), gravities=(9.81,))
     data = synthetic_measurements({}, rng, cond=cond)
-    d = discover(data, seed=0, candidates=["sidewall", "gravity_cohesion", "slip_sinkage"])
-    assert set(d.skipped) == {"sidewall", "gravity_cohesion"}
+    d = discover(data, seed=0, candidates=["sidewall", "gravity_cohesion", "gravity_pressure", "slip_sinkage"])
+    assert set(d.skipped) == {"sidewall", "gravity_cohesion", "gravity_pressure"}
     assert [c.extension.name for c in d.candidates] == ["slip_sinkage"]
+    assert d.found == [] and len(d.steps) == 1
+
+
+def test_gravity_pressure_needs_three_gravity_levels():
+    """With k'_c free, two gravity levels fix c k'_c + rho g b k'_phi g^-eps at both exactly: the exponent cannot
+    be told from the split between k'_c and k'_phi, so the mechanism is not tried; a third level can show it."""
+    from wheelsoil.validation.extensions import EXTENSIONS
+
+    two = synthetic_measurements({}, np.random.default_rng(0), cond=conditions(gravities=(9.81, 1.62)))
+    three = synthetic_measurements({}, np.random.default_rng(0), cond=conditions())
+    assert not EXTENSIONS["gravity_pressure"].applies(two) and EXTENSIONS["gravity_pressure"].applies(three)
+    assert EXTENSIONS["gravity_cohesion"].applies(two)
 
 
 def test_holdout_by_level_and_bad_requests():
@@ -103,3 +161,5 @@ def test_holdout_by_level_and_bad_requests():
         holdout_mask(data, by="slip_angle", level=45.0)
     with pytest.raises(WheelsoilInputError, match="unknown response"):
         discover(data, responses=["power"])
+    with pytest.raises(WheelsoilInputError, match="unknown candidate"):
+        discover(data, candidates=["magic"])

@@ -65,7 +65,7 @@ def test_bad_files_name_the_problem(tmp_path):
     missing = tmp_path / "grouser_wheel_trials.csv"
     missing.write_text("slip,drawbar_pull_N\n0.1,3\n")
     (tmp_path / "smooth_wheel_trials.csv").write_text("slip,drawbar_pull_N\n0.1,3\n")
-    with pytest.raises(WheelsoilInputError, match=r"missing column\(s\) \['steering_angle'"):
+    with pytest.raises(WheelsoilInputError, match=r"missing column\(s\) \['wheel', 'steering_angle'"):
         load_cmu_trials(tmp_path)
 
 

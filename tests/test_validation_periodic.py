@@ -169,7 +169,7 @@ def test_a_fitted_law_needs_spare_runs():
     from wheelsoil.validation.periodic import SPARE_RUNS, Component, Run, explain_frequencies
 
     def runs(slips):
-        return [Run(1.0, s, Component(frequency=10.0 + 5.0 * s, amplitude=1.0, phase=0.0, p_value=1e-9, explained=0.5))
+        return [Run(1.0, s, Component(frequency=10.0 - 5.0 * s, amplitude=1.0, phase=0.0, p_value=1e-9, explained=0.5))
                 for s in slips]
 
     assert explain_frequencies(runs([0.1, 0.4, 0.7]), grousers=24)["found"] is None
@@ -184,3 +184,32 @@ def test_cli_periodic_report_of_a_folder_without_runs_is_an_input_error(tmp_path
     assert main(["validate", str(tmp_path), "--periodic", "torque"]) == EXIT_INPUT
     err = capsys.readouterr().err
     assert "holds no finished runs" in err and "Traceback" not in err
+
+
+def _component(f):
+    from wheelsoil.validation.periodic import Component
+
+    return Component(frequency=f, amplitude=1.0, phase=0.0, p_value=1e-9, explained=0.5)
+
+
+def test_a_slip_law_of_the_wrong_sign_is_not_seed_002s():
+    """Seed 002 eq. 25: the density wave's frequency falls with slip. Frequencies that rise with slip along a
+    line are not named as that law."""
+    runs = [Run(w, s, _component(4.0 + 3.0 * s)) for w in (1.0, 2.0) for s in (0.1, 0.3, 0.5, 0.7)]
+    out = explain_frequencies(runs, grousers=24, spokes=12)
+    assert out["found"] is None and out["laws"]["slip_density_wave"]["seed_002_sign"] is False
+    assert "opposite of seed 002" in out["note"]
+
+
+@pytest.mark.parametrize("count", [7, 12])
+def test_wheel_speed_tied_to_slip_is_reported_as_a_confound(count):
+    """Constant carriage speed (omega = v / (r (1 - i))): a count per turn rises with slip like a line would. With
+    a count the wheel does not declare (7), nothing is named: the only line that fits has the wrong sign for seed
+    002 and no declared count fits. With the declared spoke count (12), spoke stiffness is still named (a
+    parameter-free law, and the wrong-sign slip law is no alternative), and the confound is reported."""
+    v, r = 0.05, 0.15
+    runs = [Run(v / (r * (1 - s)), s, _component(count * v / (r * (1 - s)) / (2 * np.pi)))
+            for s in (0.05, 0.15, 0.25, 0.35, 0.45, 0.55)]
+    out = explain_frequencies(runs, grousers=24, spokes=12)
+    assert out["speed_slip_r2"] > 0.999 and "tied to the slip" in out["confound"]
+    assert out["found"] == (None if count == 7 else "spoke_stiffness"), out

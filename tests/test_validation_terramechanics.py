@@ -214,3 +214,32 @@ def test_multipass_is_seed003_eq23_compaction_of_density_and_cohesion():
         assert np.all(later["sinkage"] < first["sinkage"])  # compacted soil carries the load with less sinkage
     with pytest.raises(WheelsoilInputError, match=r"passes\[0\] = 0.0 is out of range"):
         predict(soil, wheel, slip=0.2, load=50.0, passes=0)
+
+
+def test_constant_pressure_modulus_makes_sinkage_independent_of_gravity_at_equal_load():
+    """kphi_gravity_exponent = 1 turns Reece's rho g b k'_phi into seed 000's constant K_phi (ref. [32]): the normal
+    stress no longer depends on g, nor does the shear (Mohr-Coulomb on that stress), so at equal load the sinkage,
+    drawbar pull and torque are the same at any gravity -- exactly, not approximately (sidewall and grousers off:
+    they carry rho g of their own)."""
+    soil = replace(SAND, kphi_gravity_exponent=1.0, sidewall_scale=0.0, grouser_scale=0.0)
+    out = [predict(soil, WHEEL, slip=[0.1, 0.4], slip_angle=10.0, load=80.0, gravity=g) for g in (9.81, 3.71, 1.62)]
+    for other in out[1:]:
+        for q in ("sinkage", "drawbar_pull", "torque", "lateral_force"):
+            assert other[q] == pytest.approx(out[0][q], rel=1e-9, abs=1e-12), q
+    # and Reece's form (epsilon = 0) does depend on gravity
+    reece = [predict(replace(soil, kphi_gravity_exponent=0.0), WHEEL, slip=0.1, load=80.0, gravity=g)["sinkage"]
+             for g in (9.81, 1.62)]
+    assert reece[1] > 1.2 * reece[0]
+
+
+def test_gravity_soil_flow_is_the_soil_flow_of_seed000_eq8_at_each_gravity():
+    """eta(g) = eta_g (1 - g / 9.81): none at Earth gravity, and at lunar gravity exactly the constant soil flow of
+    that value."""
+    at_earth = predict(replace(SAND, soil_flow_gravity=0.4), WHEEL, slip=0.3, load=60.0, gravity=9.81)
+    plain = predict(SAND, WHEEL, slip=0.3, load=60.0, gravity=9.81)
+    assert at_earth["drawbar_pull"] == pytest.approx(plain["drawbar_pull"], rel=1e-12)
+    moon = predict(replace(SAND, soil_flow_gravity=0.4), WHEEL, slip=0.3, load=60.0, gravity=1.62)
+    same = predict(replace(SAND, soil_flow=0.4 * (1 - 1.62 / 9.81)), WHEEL, slip=0.3, load=60.0, gravity=1.62)
+    for q in ("drawbar_pull", "torque", "sinkage"):
+        assert moon[q] == pytest.approx(same[q], rel=1e-12), q
+    assert moon["drawbar_pull"] < predict(SAND, WHEEL, slip=0.3, load=60.0, gravity=1.62)["drawbar_pull"]

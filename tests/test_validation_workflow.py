@@ -6,20 +6,26 @@ import os
 import pytest
 
 from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
+from wheelsoil.validation.extensions import EXTENSIONS
 from wheelsoil.validation.workflow import validate
 
 
 @pytest.mark.slow
-def test_cmu_large_steering_angles_need_sidewall_resistance(measured_dir, tmp_path):
-    """Calibrated on steering angles up to 45 deg, the classical model misses the lateral force at 60 deg;
-    of the candidate mechanisms, Schwanghart's sidewall resistance (seed 003 eq. 19) is the one that earns its
-    parameter there: it lowers BIC and the held-out error beyond two bootstrap standard deviations."""
+def test_cmu_large_steering_angles_sidewall_helps_but_is_not_named(measured_dir, tmp_path):
+    """Calibrated on steering angles up to 45 deg, the classical model misses the lateral force at 60 deg.
+    Schwanghart's sidewall resistance (seed 003 eq. 19) predicts the held-out angle better, beyond two bootstrap
+    standard deviations, but it removes a small share of the systematic residual on the training angles: the
+    model's error there follows the slip and the wheel in forms no candidate holds. The honest verdict is
+    "nothing named; these trends unexplained", with the baseline's parameters at their bounds flagged."""
     findings = validate(os.path.join(measured_dir, "cmu_3d_terramechanics"), report=tmp_path, holdout="slip_angle=60")
-    found = findings["found"]
-    assert found is not None and found["name"] == "sidewall"
-    assert found["gain"] > 2 * found["gain_std"] > 0
-    assert found["heldout_rmse"] < findings["baseline"]["heldout_rmse"]
-    assert (tmp_path / "report.md").read_text().count("sidewall") >= 2
+    sidewall = next(c for c in findings["steps"][0]["candidates"] if c["name"] == "sidewall")
+    assert sidewall["gain"] > 2 * sidewall["gain_std"] > 0
+    assert sidewall["gain"] == max(c["gain"] for c in findings["steps"][0]["candidates"])
+    assert not sidewall["checks"]["signature"] and not sidewall["accepted"]
+    assert findings["found"] == [] and findings["unexplained"]
+    assert findings["baseline"]["at_bounds"]
+    report = (tmp_path / "report.md").read_text()
+    assert "found: nothing" in report and "unexplained: error in lateral force" in report
     for png in ("fits.png", "residuals.png", "candidates.png"):
         assert (tmp_path / png).stat().st_size > 0
     assert json.loads((tmp_path / "findings.json").read_text())["n_heldout"] > 0
@@ -30,11 +36,21 @@ def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
     out = tmp_path / "syn"
     assert main(["validate", "synthetic", "--hidden", "slip_sinkage", "--seed", "4", "--report", str(out)]) == EXIT_OK
     findings = json.loads((out / "findings.json").read_text())
-    assert findings["found"]["name"] == "slip_sinkage"
-    assert all(type(c["found"]) is bool for c in findings["candidates"])  # booleans, not 0.0
-    assert "Hidden: slip_sinkage" in (out / "report.md").read_text()
+    assert findings["found"] == ["slip_sinkage"]
+    for s in findings["steps"]:  # booleans, not 0.0
+        for c in s["candidates"]:
+            assert all(type(c[k]) is bool for k in ("accepted", "named", "passes"))
+            assert all(type(v) is bool for v in c["checks"].values())
+    report = (out / "report.md").read_text()
+    assert "Hidden: slip_sinkage" in report
+    # one truth: the terminal, the report's verdict and the JSON name the same mechanisms
+    terminal = capsys.readouterr().out
+    verdict = report.split("## Verdict")[1].split("##")[0]
+    for text in (terminal, verdict):
+        assert "found: slip_sinkage" in text.replace("\n", " ")
+        assert not any(f"found: {n}" in text for n in EXTENSIONS if n != "slip_sinkage")
+    assert (out / "model.json").is_file()
     assert (out / "synthetic_data.csv").stat().st_size > 0
-    capsys.readouterr()
     assert main(["validate", "synthetic", "--hidden", "magic", "--report", str(out)]) == EXIT_INPUT
     assert "--hidden 'magic'" in capsys.readouterr().err
     assert main(["validate", str(tmp_path / "missing.csv"), "--report", str(out)]) == EXIT_INPUT

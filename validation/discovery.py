@@ -1,125 +1,65 @@
-"""Calibrate the classical model, find what it gets wrong, name the mechanism, measure the gain.
+"""Calibrate the classical model, find what it gets wrong, name the mechanisms, measure the gain.
 
-Workflow (architecture, validation): measurements -> baseline fit on training conditions -> residual
-diagnostics against each condition variable -> for every candidate :class:`~.extensions.Extension` the data
-can show, a fit of the baseline plus that mechanism on the same training conditions -> error on the held-out
-conditions with and without it, bootstrap uncertainty of the gain, and the Bayesian information criterion
-on the training fit -> the mechanism found (or none).
+Workflow (architecture, validation): measurements -> the classical model calibrated on the training rows with
+every parameter the data can inform free (:data:`~.extensions.BASELINE_FREE`; unidentified and at-bound
+parameters flagged, :mod:`.calibration`) -> **forward selection** over the candidate mechanisms the data can show
+(:data:`~.extensions.EXTENSIONS`): at each step every remaining candidate is added in turn to the current model
+and the whole model is recalibrated; the candidate that passes every check below with the lowest BIC is accepted,
+the current model becomes that fit, and the remaining candidates are tested again, until none passes.
 
-A mechanism is *found* when its fit lowers BIC by more than :data:`BIC_MARGIN` (strong evidence, Kass &
-Raftery 1995) and its held-out gain is positive beyond :data:`GAIN_SIGMAS` bootstrap standard deviations;
-among several, the largest held-out gain wins. Residuals are normalised per response by a scale (the
-measured spread, or the measurement standard deviation where the data give one) so that forces and
-sinkage weigh alike.
+A candidate passes a step when
+
+1. **evidence**: its fit lowers BIC by more than :data:`BIC_MARGIN` (strong evidence, Kass & Raftery 1995);
+2. **prediction**: its gain in held-out RMSE over the current model is positive beyond :data:`GAIN_SIGMAS`
+   bootstrap standard deviations;
+3. **physical parameter**: none of its parameters sits at a bound of its range that the data push against (a
+   bound that binds: the mechanism takes all it may), and each lies on the side of its off value that the
+   mechanism's own description requires (:attr:`~.extensions.Parameter.sign`);
+4. **signature**: it removes most of the current model's systematic residual in the responses it moves
+   (:func:`~.residuals.systematic_residual`: at least :data:`MIN_EXPLAINED` of it). A mechanism that only
+   resembles the cause takes part of the misfit and leaves the rest; this is what keeps an effect the catalogue
+   does not hold from being given the nearest name.
+
+Two candidates that both pass and whose BICs are within :data:`AMBIGUITY_MARGIN` explain the same residual about
+equally well: the model with both is fitted, and if the second adds nothing beyond the first (BIC not lower by
+:data:`BIC_MARGIN`, or its parameter at a bound) the step reports an **ambiguity** between them and selection stops
+there, instead of picking one. What the final model still leaves systematic is reported as **unexplained**
+(:func:`~.residuals.unexplained_trends`), and an accepted mechanism that moves a response where a systematic
+residual remains is reported as a **partial** explanation, not named as the cause: the misfit has a form the
+mechanism does not hold. Residuals are normalised per response by the training data's spread.
 """
 
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.stats import spearmanr
 
 from wheelsoil.errors import WheelsoilInputError
 
-from .extensions import BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, Parameter
+from .calibration import (
+    RESPONSES,
+    Fit,
+    calibrate,
+    calibrate_baseline,
+    model_responses,
+    normalised_residuals,
+    response_scales,
+)
+from .extensions import BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension
 from .measured import Measurements
-from .terramechanics import RigidWheel, SoilParameters, predict
+from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
+from .terramechanics import SoilParameters
+
+__all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "RESPONSES", "Candidate",
+           "Discovery", "Fit", "Step", "discover", "holdout_mask", "mechanism_effect", "model_responses",
+           "normalised_residuals", "response_scales"]
 
 BIC_MARGIN = 10.0
 GAIN_SIGMAS = 2.0
-RESPONSES = ("drawbar_pull", "lateral_force", "sinkage", "torque")
-CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height")
-
-
-def model_responses(soil: SoilParameters, data: Measurements) -> dict[str, np.ndarray]:
-    """The model's drawbar pull, lateral force, sinkage and torque at every measured condition."""
-    out = {q: np.full(len(data), np.nan) for q in RESPONSES}
-    wheels = np.stack([data.radius, data.width, data.grouser_height, data.grouser_count], axis=1)
-    for key in np.unique(wheels, axis=0):
-        rows = np.all(wheels == key, axis=1)
-        wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
-        pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
-                       gravity=data.gravity[rows], passes=data.passes[rows])
-        for q in RESPONSES:
-            out[q][rows] = pred[q]
-    return out
-
-
-def response_scales(data: Measurements, responses) -> dict[str, float]:
-    """Per-response normalisation [response units]: the spread of the measured values."""
-    scales = {}
-    for q in responses:
-        y = data.responses[q]
-        y = y[np.isfinite(y)]
-        spread = float(np.std(y)) if y.size > 1 else 0.0
-        scales[q] = spread if spread > 0 else max(float(np.max(np.abs(y))) if y.size else 1.0, 1e-12)
-    return scales
-
-
-@dataclass
-class Fit:
-    """One calibration: the fitted soil, its free parameters and its training residuals."""
-
-    soil: SoilParameters
-    free: dict[str, float]
-    residuals: np.ndarray
-    success: bool
-    message: str = ""
-
-    @property
-    def n(self) -> int:
-        return int(self.residuals.size)
-
-    @property
-    def k(self) -> int:
-        return len(self.free)
-
-    @property
-    def sse(self) -> float:
-        return float(np.sum(self.residuals ** 2))
-
-    @property
-    def rmse(self) -> float:
-        return float(np.sqrt(self.sse / max(self.n, 1)))
-
-    @property
-    def bic(self) -> float:
-        return self.n * np.log(max(self.sse, 1e-300) / self.n) + self.k * np.log(self.n)
-
-
-def normalised_residuals(soil, data, responses, scales) -> np.ndarray:
-    pred = model_responses(soil, data)
-    parts = []
-    for q in responses:
-        y = data.responses[q]
-        ok = np.isfinite(y)
-        parts.append((pred[q][ok] - y[ok]) / scales[q])
-    return np.concatenate(parts) if parts else np.zeros(0)
-
-
-def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, ...], *, responses, scales,
-              max_evaluations: int = 400) -> Fit:
-    """Least-squares fit of ``free`` (bounded, log-transformed where marked) from ``start``."""
-    names = [p.name for p in free]
-
-    def soil_of(x):
-        values = {p.name: p.from_fit(v) for p, v in zip(free, x)}
-        if "shear_modulus_x" in values and "shear_modulus_y" not in values:
-            values["shear_modulus_y"] = values["shear_modulus_x"]
-        return replace(start, **values)
-
-    def residual(x):
-        try:
-            return normalised_residuals(soil_of(x), data, responses, scales)
-        except WheelsoilInputError:  # a combination outside the model's domain (e.g. a1 + a2 > 1)
-            return np.full(n_res, 1e3)
-
-    n_res = normalised_residuals(start, data, responses, scales).size
-    lo, hi = np.array([p.fit_bounds for p in free]).T
-    x0 = np.clip([p.to_fit(getattr(start, p.name)) for p in free], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-    sol = least_squares(residual, x0, bounds=(lo, hi), x_scale="jac", max_nfev=max_evaluations, diff_step=1e-4)
-    soil = soil_of(sol.x)
-    return Fit(soil, {n: getattr(soil, n) for n in names}, residual(sol.x), bool(sol.success), sol.message)
+AMBIGUITY_MARGIN = 10.0
+#: Share of the current model's systematic residual an accepted mechanism must remove.
+MIN_EXPLAINED = 0.5
+#: A mechanism "moves" a response when its effect's RMS there is at least this share of the response's spread.
+MOVES_RESPONSE = 0.05
 
 
 def holdout_mask(data: Measurements, *, fraction: float = 0.3, by: str | None = None, level=None,
@@ -138,81 +78,10 @@ def holdout_mask(data: Measurements, *, fraction: float = 0.3, by: str | None = 
     return mask
 
 
-def residual_trends(soil, data, responses, scales) -> list[dict]:
-    """Spearman rank correlation of each response's residual with each condition variable that varies."""
-    pred = model_responses(soil, data)
-    rows = []
-    for q in responses:
-        y = data.responses[q]
-        ok = np.isfinite(y)
-        res = (pred[q] - y) / scales[q]
-        for c in CONDITIONS:
-            x = np.asarray(getattr(data, c), float)
-            if ok.sum() < 4 or np.ptp(x[ok]) == 0:
-                continue
-            rho, p = spearmanr(x[ok], res[ok])
-            rows.append({"response": q, "condition": c, "spearman": float(rho), "p_value": float(p)})
-    return sorted(rows, key=lambda r: r["p_value"])
-
-
-@dataclass
-class Candidate:
-    """An extension's evidence: training fit, held-out error, bootstrap gain over the baseline, BIC."""
-
-    extension: Extension
-    fit: Fit
-    heldout_rmse: float
-    gain: float  # baseline held-out RMSE - extended held-out RMSE (normalised units)
-    gain_std: float
-    delta_bic: float
-    effect: float  # RMS of the normalised responses the mechanism adds to the fitted model
-
-    @property
-    def found(self) -> bool:
-        return bool(self.delta_bic < -BIC_MARGIN and self.gain > GAIN_SIGMAS * self.gain_std and self.gain > 0)
-
-    def to_dict(self) -> dict:
-        return {"name": self.extension.name, "mechanism": self.extension.mechanism, "source": self.extension.source,
-                "parameters": {p.name: self.fit.free[p.name] for p in self.extension.parameters},
-                "train_rmse": self.fit.rmse, "heldout_rmse": self.heldout_rmse, "gain": self.gain,
-                "gain_std": self.gain_std, "delta_bic": self.delta_bic, "effect": self.effect, "found": self.found}
-
-
-@dataclass
-class Discovery:
-    """What the workflow found: the baseline, every candidate ranked, and the mechanism found (or None)."""
-
-    baseline: Fit
-    baseline_heldout_rmse: float
-    candidates: list[Candidate]
-    trends: list[dict]
-    responses: tuple
-    scales: dict
-    n_train: int
-    n_heldout: int
-    skipped: dict = field(default_factory=dict)
-
-    @property
-    def found(self) -> Candidate | None:
-        hits = [c for c in self.candidates if c.found]
-        return max(hits, key=lambda c: c.gain) if hits else None
-
-    def to_dict(self) -> dict:
-        f = self.found
-        return {
-            "responses": list(self.responses), "scales": self.scales, "n_train": self.n_train,
-            "n_heldout": self.n_heldout,
-            "baseline": {"parameters": self.baseline.free, "train_rmse": self.baseline.rmse,
-                         "heldout_rmse": self.baseline_heldout_rmse},
-            "candidates": [c.to_dict() for c in self.candidates],
-            "found": f.to_dict() if f else None,
-            "residual_trends": self.trends[:12],
-            "not_applicable": self.skipped,
-        }
-
-
-def mechanism_effect(soil: SoilParameters, extension: Extension, data: Measurements, responses, scales) -> float:
-    """RMS over conditions and responses of what ``extension`` adds to the model ``soil`` (normalised).
+def mechanism_effect(soil: SoilParameters, extension: Extension, data: Measurements, responses, scales, *,
+                     by_response: bool = False):
+    """RMS over conditions and responses of what ``extension`` adds to the model ``soil`` (normalised); with
+    ``by_response`` a dict of the RMS per response.
 
     Scale-type parameters (sidewall, grouser) multiply formulas that also hold cohesion and friction, so a
     fit may trade the scale against them; the mechanism's contribution to the responses is what the data
@@ -220,38 +89,221 @@ def mechanism_effect(soil: SoilParameters, extension: Extension, data: Measureme
     """
     on = model_responses(soil, data)
     off = model_responses(replace(soil, **extension.off), data)
-    parts = [(on[q] - off[q]) / scales[q] for q in responses]
-    return float(np.sqrt(np.mean(np.concatenate(parts) ** 2)))
+    parts = {q: (on[q] - off[q]) / scales[q] for q in responses}
+    if by_response:
+        return {q: float(np.sqrt(np.mean(v ** 2))) for q, v in parts.items()}
+    return float(np.sqrt(np.mean(np.concatenate(list(parts.values())) ** 2)))
 
 
-def _best_extended(train, baseline: SoilParameters, start: SoilParameters, ext: Extension, responses, scales) -> Fit:
-    """Baseline plus ``ext`` fitted from the baseline fit, and from the baseline fit with the cohesion of
-    ``start`` and the extension's parameters mid-range: a baseline fit can park a parameter where the
-    mechanism has no gradient (cohesion 0 for a gravity-scaled cohesion)."""
-    free = BASELINE_FREE + ext.parameters
-    mid = {p.name: p.from_fit(0.5 * sum(p.fit_bounds)) for p in ext.parameters}
-    starts = [baseline, replace(baseline, cohesion=max(baseline.cohesion, start.cohesion), **mid)]
-    fits = [calibrate(train, s, free, responses=responses, scales=scales) for s in starts]
+def _lack_of_fit(soil: SoilParameters, data: Measurements, responses, scales) -> tuple[dict, list[dict]]:
+    """Systematic residual and Spearman trends of ``soil`` on ``data``."""
+    res = normalised_residuals(soil, data, responses, scales, split=True)
+    rows = {q: np.isfinite(data.responses[q]) for q in responses}
+    return systematic_residual(res, data, rows), residual_trends(res, data, rows)
+
+
+def _parameter_problems(ext: Extension, fit: Fit) -> list[str]:
+    """Why the fitted parameters of ``ext`` are not a physical instance of the mechanism (empty: they are): a
+    bound the data push against (:meth:`~.calibration.Fit.binding_bounds`; a saturating parameter resting on
+    its search bound is a one-sided estimate, not a problem), or the opposite sign to the mechanism's."""
+    problems = []
+    binding = fit.binding_bounds()
+    for p in ext.parameters:
+        v = fit.free[p.name]
+        if p.name in binding:
+            problems.append(f"{p.name} = {v:.4g} at its {binding[p.name]} bound, which the data push against")
+        off = ext.off[p.name]
+        if p.sign and np.sign(v - off) != p.sign:
+            problems.append(f"{p.name} = {v:.4g}: the opposite of the mechanism ({'above' if p.sign > 0 else 'below'}"
+                            f" {off:g} expected)")
+    return problems
+
+
+@dataclass
+class Candidate:
+    """A mechanism tested at one selection step: its fit added to the current model, the evidence and checks."""
+
+    extension: Extension
+    step: int
+    fit: Fit
+    heldout_rmse: float
+    gain: float  # current model's held-out RMSE - this fit's (normalised units)
+    gain_std: float
+    delta_bic: float  # against the current model
+    effect: float  # RMS of the normalised responses the mechanism adds to the fitted model
+    explained: float  # share of the current model's systematic residual this fit removes
+    problems: list[str] = field(default_factory=list)  # parameter at a bound / opposite sign
+    accepted: bool = False
+    effect_by_response: dict = field(default_factory=dict)
+    #: accepted by the selection, but the final model still leaves a systematic residual in a response this
+    #: mechanism moves: it explains part of the misfit and is not named as its cause
+    partial: list[str] = field(default_factory=list)
+
+    def moves(self) -> list[str]:
+        """The responses this mechanism changes by at least :data:`MOVES_RESPONSE` of their spread."""
+        return [q for q, v in self.effect_by_response.items() if v >= MOVES_RESPONSE]
+
+    @property
+    def checks(self) -> dict[str, bool]:
+        return {"evidence": bool(self.delta_bic < -BIC_MARGIN),
+                "prediction": bool(self.gain > 0 and self.gain > GAIN_SIGMAS * self.gain_std),
+                "physical_parameter": not self.problems,
+                "signature": bool(self.explained >= MIN_EXPLAINED)}
+
+    @property
+    def passes(self) -> bool:
+        return all(self.checks.values())
+
+    def reasons(self) -> list[str]:
+        """Why it did not pass (empty when it did)."""
+        c, out = self.checks, []
+        if not c["evidence"]:
+            out.append(f"ΔBIC {self.delta_bic:+.1f} (needs < -{BIC_MARGIN:g})")
+        if not c["prediction"]:
+            out.append(f"held-out gain {self.gain:+.4f} ± {self.gain_std:.4f}")
+        out += self.problems
+        if not c["signature"]:
+            out.append(f"removes {100 * self.explained:.0f} % of the systematic residual (needs "
+                       f"{100 * MIN_EXPLAINED:.0f} %)")
+        return out
+
+    def parameters(self) -> dict[str, float]:
+        return {p.name: self.fit.free[p.name] for p in self.extension.parameters}
+
+    def to_dict(self) -> dict:
+        table = {r["name"]: r for r in self.fit.parameter_table()}
+        return {"name": self.extension.name, "mechanism": self.extension.mechanism, "source": self.extension.source,
+                "step": self.step,
+                "parameters": {p.name: {"value": table[p.name]["value"], "std_error": table[p.name]["std_error"],
+                                        "unit": p.unit, "at_bound": table[p.name]["at_bound"]}
+                               for p in self.extension.parameters},
+                "train_rmse": self.fit.rmse, "heldout_rmse": self.heldout_rmse, "gain": self.gain,
+                "gain_std": self.gain_std, "delta_bic": self.delta_bic, "effect": self.effect,
+                "explained": self.explained, "checks": self.checks, "passes": self.passes,
+                "accepted": bool(self.accepted), "named": bool(self.accepted and not self.partial),
+                "moves": self.moves(), "partial_because": self.partial, "why_not": self.reasons()}
+
+
+@dataclass
+class Step:
+    """One round of forward selection: the model it started from and every candidate tried on it."""
+
+    index: int
+    model: tuple[str, ...]
+    heldout_rmse: float
+    systematic: float
+    candidates: list[Candidate]
+    accepted: str | None = None
+    ambiguity: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {"step": self.index, "model": list(self.model), "heldout_rmse": self.heldout_rmse,
+                "systematic_residual": self.systematic, "accepted": self.accepted, "ambiguity": self.ambiguity,
+                "candidates": [c.to_dict() for c in self.candidates]}
+
+
+@dataclass
+class Discovery:
+    """What the workflow found: the calibrated baseline, each selection step, the accepted mechanisms, any
+    ambiguity, and what the final model leaves unexplained."""
+
+    baseline: Fit
+    baseline_heldout_rmse: float
+    steps: list[Step]
+    final: Fit
+    final_heldout_rmse: float
+    trends: list[dict]  # the baseline's residual trends (training rows)
+    lack_of_fit: dict  # {"baseline": ..., "final": ...}
+    unexplained: list[dict]
+    responses: tuple
+    scales: dict
+    n_train: int
+    n_heldout: int
+    skipped: dict = field(default_factory=dict)
+
+    @property
+    def accepted(self) -> list[Candidate]:
+        """Every mechanism the selection accepted (named or partial), in the order accepted."""
+        return [c for s in self.steps for c in s.candidates if c.accepted]
+
+    @property
+    def found(self) -> list[str]:
+        """Names of the mechanisms named as causes: accepted, and the final model leaves no systematic residual
+        in a response they move."""
+        return [c.extension.name for c in self.accepted if not c.partial]
+
+    @property
+    def partial(self) -> list[Candidate]:
+        """Accepted mechanisms not named: the final model still leaves a systematic residual where they act."""
+        return [c for c in self.accepted if c.partial]
+
+    @property
+    def ambiguities(self) -> list[list[str]]:
+        return [s.ambiguity for s in self.steps if s.ambiguity]
+
+    @property
+    def candidates(self) -> list[Candidate]:
+        """The first step's candidates (every mechanism tried on the classical model), best BIC first."""
+        return self.steps[0].candidates if self.steps else []
+
+    def explained_share(self) -> float:
+        """Share of the baseline's systematic residual (training rows) the final model removes."""
+        before = self.lack_of_fit["baseline"]["systematic"]
+        return 1.0 - self.lack_of_fit["final"]["systematic"] / before if before > 0 else 1.0
+
+    def to_dict(self) -> dict:
+        def model(fit, heldout):
+            return {"parameters": fit.free, "parameter_table": fit.parameter_table(), "train_rmse": fit.rmse,
+                    "heldout_rmse": heldout, "at_bounds": fit.at_bounds(), "unidentified": sorted(fit.unidentified())}
+
+        return {
+            "responses": list(self.responses), "scales": self.scales, "n_train": self.n_train,
+            "n_heldout": self.n_heldout,
+            "found": self.found,
+            "accepted": [c.to_dict() for c in self.accepted if not c.partial],
+            "partial": [c.to_dict() for c in self.partial],
+            "ambiguities": self.ambiguities,
+            "unexplained": self.unexplained,
+            "baseline": model(self.baseline, self.baseline_heldout_rmse),
+            "final": {"mechanisms": [c.extension.name for c in self.accepted], **model(self.final, self.final_heldout_rmse),
+                      "explained_share": self.explained_share()},
+            "steps": [s.to_dict() for s in self.steps],
+            "residual_trends": self.trends[:12],
+            "lack_of_fit": {k: {q: {"p_value": r["p_value"], "systematic": r["systematic"]}
+                                for q, r in v["responses"].items()} for k, v in self.lack_of_fit.items()},
+            "not_applicable": self.skipped,
+        }
+
+
+def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[Extension, ...], responses,
+                  scales) -> Fit:
+    """The current model plus ``exts`` fitted from the current fit, and from the current fit with the cohesion
+    of ``start`` and the new parameters mid-range: a fit can park a parameter where a mechanism has no gradient
+    (cohesion 0 for a gravity-scaled cohesion)."""
+    params = tuple(p for e in exts for p in e.parameters)
+    mid = {p.name: p.from_fit(0.5 * sum(p.fit_bounds)) for p in params}
+    starts = [current.soil, replace(current.soil, cohesion=max(current.soil.cohesion, start.cohesion), **mid)]
+    fits = []
+    for s in starts:
+        try:
+            fits.append(calibrate(train, s, free + params, responses=responses, scales=scales))
+        except WheelsoilInputError:  # a mid-range start outside the model's domain (a1 + a2 > 1)
+            continue
     return min(fits, key=lambda f: f.sse)
 
 
-def _best_baseline(train, start, responses, scales) -> Fit:
-    """The baseline from the given start and from two generic dry-sand starts; the lowest error wins
-    (the classical model's error surface has flat valleys, e.g. in theta_m / theta_f)."""
-    starts = [start, replace(start, a1=0.35, n0=1.0, shear_modulus_x=0.02, shear_modulus_y=0.02),
-              replace(start, a1=0.2, n0=0.8, friction_angle=30.0, cohesion=100.0, kphi_prime=500.0)]
-    fits = [calibrate(train, s, BASELINE_FREE, responses=responses, scales=scales) for s in starts]
-    return min(fits, key=lambda f: f.sse)
+def _heldout(soil, test, responses, scales) -> np.ndarray:
+    return normalised_residuals(soil, test, responses, scales)
 
 
 def discover(data: Measurements, *, start: SoilParameters | None = None, responses=None, heldout=None,
-             candidates=None, bootstrap: int = 400, seed: int = 0) -> Discovery:
+             candidates=None, bootstrap: int = 400, seed: int = 0, max_steps: int = 4) -> Discovery:
     """Run the workflow on ``data`` (see the module docstring).
 
     start: parameters to start from; the baseline's extension parameters are switched off
         (:data:`~.extensions.BASELINE_OFF`). responses: which measured responses to fit (default: those
         with data). heldout: boolean mask of held-out rows (default: a seeded random 30 %). candidates:
-        extension names to try (default: all that the data can show).
+        extension names to try (default: all that the data can show). max_steps: most mechanisms accepted.
     """
     if len(data) < 8:
         raise WheelsoilInputError(f"{data.name}: {len(data)} measurements are too few to calibrate and hold out")
@@ -259,30 +311,74 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
     unknown = [q for q in responses if q not in RESPONSES]
     if unknown:
         raise WheelsoilInputError(f"unknown response(s) {unknown}; choose from {list(RESPONSES)}")
+    names = list(candidates or EXTENSIONS)
+    bad = [n for n in names if n not in EXTENSIONS]
+    if bad:
+        raise WheelsoilInputError(f"unknown candidate(s) {bad}; choose from {sorted(EXTENSIONS)}")
     heldout = holdout_mask(data, seed=seed) if heldout is None else np.asarray(heldout, bool)
     train, test = data.select(~heldout), data.select(heldout)
-    scales = response_scales(data, responses)
+    scales = response_scales(train, responses)
     base_start = replace(start or SoilParameters(), **BASELINE_OFF)
-    baseline = _best_baseline(train, base_start, responses, scales)
-    base_err = normalised_residuals(baseline.soil, test, responses, scales)
-    base_rmse = float(np.sqrt(np.mean(base_err ** 2)))
+    baseline = calibrate_baseline(train, base_start, responses, scales)
+    lack_base, trends = _lack_of_fit(baseline.soil, train, responses, scales)
 
-    names = list(candidates or EXTENSIONS)
     skipped = {n: "the data cannot show it" for n in names if not EXTENSIONS[n].applies(data)}
+    remaining = [n for n in names if n not in skipped]
     rng = np.random.default_rng(seed)
-    results = []
-    for name in names:
-        if name in skipped:
-            continue
-        ext = EXTENSIONS[name]
-        fit = _best_extended(train, baseline.soil, base_start, ext, responses, scales)
-        err = normalised_residuals(fit.soil, test, responses, scales)
-        rmse = float(np.sqrt(np.mean(err ** 2)))
-        # bootstrap over held-out residuals (paired): the spread of the RMSE difference
-        idx = rng.integers(0, err.size, size=(bootstrap, err.size))
-        diffs = np.sqrt(np.mean(base_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
-        results.append(Candidate(ext, fit, rmse, base_rmse - rmse, float(np.std(diffs)), fit.bic - baseline.bic,
-                                 mechanism_effect(fit.soil, ext, data, responses, scales)))
-    results.sort(key=lambda c: -c.gain)
-    trends = residual_trends(baseline.soil, train, responses, scales)
-    return Discovery(baseline, base_rmse, results, trends, responses, scales, len(train), len(test), skipped)
+    current, current_names, free = baseline, (), BASELINE_FREE
+    lack_cur = lack_base
+    steps: list[Step] = []
+    while remaining and len(current_names) < max_steps:
+        cur_err = _heldout(current.soil, test, responses, scales)
+        cur_rmse = float(np.sqrt(np.mean(cur_err ** 2)))
+        tried = []
+        for name in remaining:
+            ext = EXTENSIONS[name]
+            fit = _fit_extended(train, current, free, base_start, (ext,), responses, scales)
+            err = _heldout(fit.soil, test, responses, scales)
+            rmse = float(np.sqrt(np.mean(err ** 2)))
+            idx = rng.integers(0, err.size, size=(bootstrap, err.size))  # paired bootstrap of the RMSE difference
+            diffs = np.sqrt(np.mean(cur_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
+            lack_new, _ = _lack_of_fit(fit.soil, train, responses, scales)
+            before = lack_cur["systematic"]
+            explained = 1.0 - lack_new["systematic"] / before if before > 0 else 0.0
+            tried.append(Candidate(ext, len(steps), fit, rmse, cur_rmse - rmse, float(np.std(diffs)),
+                                   fit.bic - current.bic, mechanism_effect(fit.soil, ext, data, responses, scales),
+                                   float(explained), _parameter_problems(ext, fit),
+                                   effect_by_response=mechanism_effect(fit.soil, ext, data, responses, scales,
+                                                                       by_response=True)))
+        tried.sort(key=lambda c: c.fit.bic)
+        step = Step(len(steps), current_names, cur_rmse, lack_cur["systematic"], tried)
+        steps.append(step)
+        passing = [c for c in tried if c.passes]
+        if not passing:
+            break
+        best = passing[0]
+        unresolved = []
+        for rival in passing[1:]:
+            if rival.fit.bic - best.fit.bic >= AMBIGUITY_MARGIN:
+                continue
+            joint = _fit_extended(train, best.fit, free + best.extension.parameters, base_start,
+                                  (rival.extension,), responses, scales)
+            if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems(rival.extension, joint):
+                unresolved.append(rival.extension.name)
+        if unresolved:
+            step.ambiguity = [best.extension.name] + unresolved
+            break
+        best.accepted = True
+        step.accepted = best.extension.name
+        current, current_names = best.fit, current_names + (best.extension.name,)
+        free = free + best.extension.parameters
+        remaining.remove(best.extension.name)
+        lack_cur, _ = _lack_of_fit(current.soil, train, responses, scales)
+    final_err = _heldout(current.soil, test, responses, scales)
+    _, final_trends = _lack_of_fit(current.soil, train, responses, scales)
+    unexplained = unexplained_trends(lack_cur, final_trends)
+    for s in steps:
+        for c in s.candidates:
+            if c.accepted:
+                c.partial = [u["text"] for u in unexplained if u["response"] in c.moves()]
+    return Discovery(baseline, float(np.sqrt(np.mean(_heldout(baseline.soil, test, responses, scales) ** 2))), steps,
+                     current, float(np.sqrt(np.mean(final_err ** 2))), trends,
+                     {"baseline": lack_base, "final": lack_cur}, unexplained, responses, scales, len(train), len(test),
+                     skipped)

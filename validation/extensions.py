@@ -20,13 +20,19 @@ import numpy as np
 @dataclass(frozen=True)
 class Parameter:
     """A free model parameter: a field of :class:`~wheelsoil.validation.terramechanics.SoilParameters`,
-    its bounds and, for positive scale parameters, a log transform for the fit."""
+    its bounds (the physical range searched) and, for positive scale parameters, a log transform for the fit.
+
+    sign: for a mechanism's parameter whose search range spans both sides of its off value, the side the
+    mechanism's own description requires (+1: above the off value, -1: below; 0: either). A fit on the other
+    side is the data asking for the opposite physics, and is not accepted as that mechanism.
+    """
 
     name: str
     lower: float
     upper: float
     log: bool = False
     unit: str = "-"
+    sign: int = 0
 
     def to_fit(self, value: float) -> float:
         return float(np.log(value)) if self.log else float(value)
@@ -37,6 +43,16 @@ class Parameter:
     @property
     def fit_bounds(self) -> tuple[float, float]:
         return (self.to_fit(self.lower), self.to_fit(self.upper))
+
+    def at_bound(self, value: float, rel: float = 1e-3) -> str | None:
+        """"lower" or "upper" when ``value`` lies within ``rel`` of the fit range of a bound, else None."""
+        lo, hi = self.fit_bounds
+        x = self.to_fit(max(value, self.lower) if self.log else value)
+        if x - lo <= rel * (hi - lo):
+            return "lower"
+        if hi - x <= rel * (hi - lo):
+            return "upper"
+        return None
 
 
 @dataclass(frozen=True)
@@ -52,9 +68,14 @@ class Extension:
     applies: Callable
 
 
-#: Parameters the classical model is calibrated on (the shear moduli are tied, k_y = k_x, as in Artemis).
+#: Parameters the classical model is calibrated on: every soil parameter of its equations that force and
+#: sinkage data can inform (the shear moduli are tied, k_y = k_x, as in Artemis). Not free: the bulk density,
+#: which is measured; the exit-angle ratio c3 (0, the soil does not rebound; seed 003 Table I); and the slip
+#: terms n1 and a2, which are mechanisms of their own (:data:`EXTENSIONS`). Bounds: the ranges of Wong's and
+#: seed 003's tables for dry sand to clayey soil, widened.
 BASELINE_FREE = (
     Parameter("kphi_prime", 10.0, 1e5, log=True),
+    Parameter("kc_prime", 0.0, 2000.0),
     Parameter("cohesion", 0.0, 2e4, unit="Pa"),
     Parameter("friction_angle", 15.0, 50.0, unit="deg"),
     Parameter("shear_modulus_x", 5e-4, 0.2, log=True, unit="m"),
@@ -74,6 +95,8 @@ BASELINE_OFF = {
     "cohesion_gravity_exponent": 0.0,
     "bulldozing_scale": 0.0,
     "multipass_k2": 0.0,
+    "kphi_gravity_exponent": 0.0,
+    "soil_flow_gravity": 0.0,
 }
 
 
@@ -88,13 +111,13 @@ EXTENSIONS = {
         Extension(
             "slip_sinkage", "sinkage exponent rising with slip: the wheel digs in as it slips",
             "seed 003 eq. 5, seed 000 eq. 4: n = n0 + n1 |i|",
-            (Parameter("n1", -0.3, 1.5),), {"n1": 0.0},
+            (Parameter("n1", -0.3, 1.5, sign=1),), {"n1": 0.0},
             lambda d: _varies(d.slip),
         ),
         Extension(
             "theta_m_slip", "angle of maximum normal stress moving forward with slip",
             "seed 003 eq. 8 (Oida; Wong--Reece): theta_m = (a1 + a2 i) theta_f",
-            (Parameter("a2", -0.3, 0.6),), {"a2": 0.0},
+            (Parameter("a2", -0.3, 0.6, sign=1),), {"a2": 0.0},
             lambda d: _varies(d.slip),
         ),
         Extension(
@@ -144,7 +167,23 @@ EXTENSIONS = {
         Extension(
             "gravity_cohesion", "soil strength that falls with gravity (cohesion ~ g^kappa)",
             "seed 000 sec. 5: measured soil strength is lower at reduced gravity",
-            (Parameter("cohesion_gravity_exponent", -1.0, 3.0),), {"cohesion_gravity_exponent": 0.0},
+            (Parameter("cohesion_gravity_exponent", -1.0, 3.0, sign=1),), {"cohesion_gravity_exponent": 0.0},
+            lambda d: _varies(d.gravity),
+        ),
+        Extension(
+            "gravity_pressure", "frictional pressure modulus that does not scale fully with gravity: sinkage "
+            "nearly independent of gravity at equal load",
+            "seed 000 eqs. 3 and 5: (K_c + K_phi g) with K_phi = rho k'_phi / b^(n-1) held constant (ref. [32]) "
+            "against Reece's gravity-explicit form; here rho g b k'_phi (g / g0)^-epsilon",
+            (Parameter("kphi_gravity_exponent", -0.5, 1.5, sign=1),), {"kphi_gravity_exponent": 0.0},
+            # with k'_c free, two gravity levels fix (c k'_c + rho g b k'_phi g^-eps) at both exactly: a third
+            # level is needed to tell the exponent from the split between k'_c and k'_phi
+            lambda d: np.unique(np.round(np.asarray(d.gravity, float), 6)).size >= 3,
+        ),
+        Extension(
+            "gravity_soil_flow", "soil under the rim carried along faster at lower gravity, lowering traction",
+            "seed 000 sec. 3.3 and eq. 8: eta(g) = eta_g (1 - g / g0) in j = r((theta_f - theta)(1 - eta) - ...)",
+            (Parameter("soil_flow_gravity", 0.0, 0.9),), {"soil_flow_gravity": 0.0},
             lambda d: _varies(d.gravity),
         ),
     )

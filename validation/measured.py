@@ -150,8 +150,13 @@ class Measurements:
             notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes))
 
 
-def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
-    """The CMU 3D-terramechanics trials (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv``).
+#: The columns of a CMU trial file (after the unit suffix is split off).
+CMU_COLUMNS = ("wheel", "steering_angle", "slip", "drawbar_pull", "lateral_force", "vertical_load", "sinkage")
+
+
+def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurements:
+    """One CMU trial file (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv`` or a file of the same
+    columns): the wheel of each row from its ``wheel`` column (``grouser`` or ``smooth``).
 
     The soil carries ``vertical_load``; sinkage is kept as recorded (the lab's zero is the wheel's start
     position, not the soil surface, so only its changes are comparable). ``driving_only`` keeps rows with
@@ -163,31 +168,47 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
     lateral slip's resistance as the lab defines it. In wheelsoil's frame (v_y = v_x tan beta) the soil
     resists the lateral slip with a force of the opposite sign to beta, so the loader flips the lab's sign.
     """
-    folder = Path(folder)
-    parts = []
-    for wheel in ("grouser", "smooth"):
-        t = load_table(folder / f"{wheel}_wheel_trials.csv")
-        t.require("steering_angle", "slip", "drawbar_pull", "lateral_force", "vertical_load", "sinkage")
-        parts.append((wheel, t))
-    cols = lambda key: np.concatenate([t.columns[key] for _, t in parts])  # noqa: E731
-    group = np.concatenate([np.full(len(t), w) for w, t in parts])
+    t = load_table(path)
+    t.require(*CMU_COLUMNS)
+    group = np.asarray(t.columns["wheel"]).astype(str)
+    unknown = sorted(set(group) - set(cmu_k10.GROUSER_HEIGHT))
+    if unknown:
+        raise WheelsoilInputError(f"{path}: column 'wheel' holds {unknown}; the CMU rig's wheels are "
+                                  f"{sorted(cmu_k10.GROUSER_HEIGHT)}")
     n = len(group)
+    col = lambda key: np.asarray(t.columns[key], float)  # noqa: E731
+    opt = lambda key: col(key) if key in t.columns else np.full(n, np.nan)  # noqa: E731
     data = Measurements(
-        name="cmu_3d_terramechanics",
-        slip=cols("slip"), slip_angle=cols("steering_angle"), load=cols("vertical_load"),
+        name=Path(path).stem,
+        slip=col("slip"), slip_angle=col("steering_angle"), load=col("vertical_load"),
         gravity=np.full(n, EARTH_GRAVITY), radius=np.full(n, cmu_k10.RADIUS), width=np.full(n, cmu_k10.WIDTH),
         grouser_height=np.array([cmu_k10.GROUSER_HEIGHT[g] for g in group]), grouser_count=np.zeros(n),
         group=group,
-        responses={"drawbar_pull": cols("drawbar_pull"), "lateral_force": -cols("lateral_force"),
-                   "sinkage": cols("sinkage"), "torque": np.full(n, np.nan)},
-        std={"drawbar_pull": cols("drawbar_pull_std"), "lateral_force": cols("lateral_force_std"),
-             "vertical_load": cols("vertical_load_std")},
+        responses={"drawbar_pull": col("drawbar_pull"), "lateral_force": -col("lateral_force"),
+                   "sinkage": col("sinkage"), "torque": np.full(n, np.nan)},
+        std={"drawbar_pull": opt("drawbar_pull_std"), "lateral_force": opt("lateral_force_std"),
+             "vertical_load": opt("vertical_load_std")},
         notes="Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position",
         sinkage_relative=True,
     )
     if driving_only:
         data = data.select((data.slip >= 0.0) & (data.slip < 1.0))
     return data
+
+
+def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
+    """The CMU 3D-terramechanics trials of a folder: both wheels' files (``grouser_wheel_trials.csv``,
+    ``smooth_wheel_trials.csv``) read by :func:`load_cmu_file` into one set."""
+    folder = Path(folder)
+    parts = [load_cmu_file(folder / f"{wheel}_wheel_trials.csv", driving_only=driving_only)
+             for wheel in ("grouser", "smooth")]
+    cat = lambda key: np.concatenate([getattr(m, key) for m in parts])  # noqa: E731
+    return Measurements(
+        "cmu_3d_terramechanics", *(cat(k) for k in ("slip", "slip_angle", "load", "gravity", "radius", "width",
+                                                    "grouser_height", "grouser_count", "group")),
+        responses={q: np.concatenate([m.responses[q] for m in parts]) for q in parts[0].responses},
+        std={q: np.concatenate([m.std[q] for m in parts]) for q in parts[0].std},
+        notes=parts[0].notes, sinkage_relative=True, passes=cat("passes"))
 
 
 def load_digitised(path: str | Path) -> Measurements:
@@ -332,6 +353,8 @@ def _load_any(path: str | Path) -> Measurements:
         raise WheelsoilInputError(f"{path} is neither a folder of CMU trials (grouser_wheel_trials.csv / "
                                   "smooth_wheel_trials.csv) nor a wheelsoil sweep folder (summary.csv)")
     header = load_table(path).columns
+    if all(c in header for c in CMU_COLUMNS):
+        return load_cmu_file(path)
     if "tread_sinkage_mean" in header:
         return load_sweep_summary(path)
     if "meas_drawbar_pull" in header:

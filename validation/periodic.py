@@ -41,6 +41,8 @@ LAW_TOLERANCE = 0.05
 BIC_MARGIN = 10.0
 #: Significant runs a fitted law needs beyond its parameters (a line through 3 points proves nothing).
 SPARE_RUNS = 3
+#: R^2 of the wheel speed explained by the slip above which the two are tied (see :func:`speed_slip_confound`).
+CONFOUND_R2 = 0.98
 
 
 @dataclass
@@ -161,6 +163,29 @@ class Run:
     component: Component
 
 
+def speed_slip_confound(omega: np.ndarray, slip: np.ndarray) -> tuple[float, str | None]:
+    """How far the runs' wheel speed is a function of their slip, and what that means for the laws.
+
+    A rig driven at constant carriage speed v sets omega = v / (r (1 - i)): every counting law then reads
+    f = N v / (2 pi r (1 - i)), a smooth function of slip that a slip law f = a + b i follows closely, so a
+    count per turn and a slip-dependent frequency cannot be told apart. The wheel speed is regressed on
+    (1, i, 1 / (1 - i)); R^2 >= :data:`CONFOUND_R2` counts as tied. Returns (R^2, a note or None); one wheel
+    speed is the limiting case (every counting law a constant)."""
+    omega, slip = np.asarray(omega, float), np.asarray(slip, float)
+    if np.ptp(omega) == 0:
+        return 1.0, ("one wheel speed: every counting law is a constant frequency, so a count per turn, a natural "
+                     "mode and (with slip held too) a slip law cannot be told apart; vary the wheel speed")
+    design = np.column_stack([np.ones_like(slip), slip, 1.0 / np.maximum(1.0 - slip, 1e-3)])
+    coef, *_ = np.linalg.lstsq(design, omega, rcond=None)
+    resid = omega - design @ coef
+    r2 = 1.0 - float(resid @ resid) / float(np.sum((omega - omega.mean()) ** 2))
+    if r2 >= CONFOUND_R2:
+        return r2, (f"the wheel speed is tied to the slip (R² = {r2:.3f}; e.g. a constant carriage speed): a count "
+                    "per turn and a slip-dependent frequency cannot be told apart; vary the wheel speed at a fixed "
+                    "slip")
+    return r2, None
+
+
 def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) -> dict:
     """Which frequency law explains the significant components of ``runs`` (see the module docstring).
 
@@ -170,6 +195,11 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
     relative error is within the same tolerance. Nothing is found without significant components in at
     least three runs, and a fitted law is considered only with :data:`SPARE_RUNS` more significant runs than
     it has parameters.
+
+    Two checks keep a law from being named where the data cannot support it: the slip law must have seed 002's
+    sign (eq. 25: the frequency falls with slip, b < 0), and where the wheel speed is tied to the slip
+    (:func:`speed_slip_confound`) a law is named only if no other law fits within the tolerance too; otherwise
+    ``ambiguous`` lists the laws that fit and ``confound`` says why.
     """
     sig = [r for r in runs if r.component.significant]
     out = {"found": None, "laws": {}, "significant_runs": len(sig)}
@@ -202,6 +232,16 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
             "parameters": {"a_hz": float(coef[1]), "b_hz": float(coef[0])},
             "bic": n * np.log(max(np.mean(rel ** 2), 1e-300)) + 2 * np.log(n),
         }
+    r2, confound = speed_slip_confound(omega, slip)
+    out["speed_slip_r2"] = r2
+    if confound and np.ptp(omega) > 0:
+        out["confound"] = confound
+    if slip_law_fit := out["laws"].get("slip_density_wave"):
+        b = slip_law_fit["parameters"]["b_hz"]
+        slip_law_fit["seed_002_sign"] = bool(b < 0)
+        if b >= 0:
+            slip_law_fit["note"] = (f"frequency rising with slip (b = {b:+.3g} Hz): the opposite of seed 002 eq. 25 "
+                                    "(omega_osc = -36.9 i + 36.5 rad/s), so not its density wave")
     counting = [k for k in out["laws"] if k not in ("slip_density_wave", "natural_mode")]
     best = min(counting, key=lambda k: out["laws"][k]["bic"])
     # a law with fitted parameters must beat the simpler laws by strong evidence: the one-parameter
@@ -212,7 +252,15 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
     if (fitted["slip_density_wave"] and slip_law
             and slip_law["bic"] < min(out["laws"][best]["bic"], out["laws"]["natural_mode"]["bic"]) - BIC_MARGIN):
         best = "slip_density_wave"
-    if out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE:
+    fitting = sorted(k for k, v in out["laws"].items() if v["rms_relative_error"] <= LAW_TOLERANCE
+                     and (k != "slip_density_wave" or (fitted["slip_density_wave"] and v["seed_002_sign"]))
+                     and (k != "natural_mode" or fitted["natural_mode"]))
+    if best == "slip_density_wave" and not slip_law["seed_002_sign"]:
+        out["note"] = slip_law["note"]
+    elif out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE and "confound" in out and len(fitting) > 1:
+        out["ambiguous"] = fitting
+        out["note"] = f"{' and '.join(fitting)} all fit: {out['confound']}"
+    elif out["laws"][best]["rms_relative_error"] <= LAW_TOLERANCE:
         if best == "natural_mode" and np.ptp(omega) == 0:
             # at one wheel speed every counting law is a constant frequency too
             out["note"] = (f"a constant frequency of {f.mean():.3g} Hz at one wheel speed: a natural mode and a "
@@ -332,6 +380,8 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
                 lines += [f"| {k} | {v['rms_relative_error']:.3f} | {v['bic']:.1f} | "
                           + ", ".join(f"{p} = {x:.3g}" for p, x in v["parameters"].items()) + " |"
                           for k, v in found["laws"].items()]
+            if "confound" in found:
+                lines += ["", f"Confound: {found['confound']}."]
             if found["found"]:
                 lines += ["", f"**{found['found']}** explains the significant components (within {LAW_TOLERANCE:.0%})."]
             elif "note" in found:

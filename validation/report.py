@@ -1,4 +1,9 @@
-"""The validation report: markdown with plots, and a JSON of the findings, for one discovery run."""
+"""The validation report: markdown with plots, and a JSON of the findings, for one discovery run.
+
+One truth: the findings dict (:meth:`Discovery.to_dict` plus the run's metadata) is built once, and the terminal
+summary (:func:`verdict_lines`), ``report.md``, ``findings.json`` and the plots' titles are all written from it, so
+they name the same accepted mechanisms, ambiguities and unexplained trends.
+"""
 
 from pathlib import Path
 
@@ -6,7 +11,7 @@ import numpy as np
 
 from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
-from .discovery import Discovery, model_responses
+from .discovery import BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, Discovery, model_responses
 from .measured import Measurements
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
@@ -20,17 +25,51 @@ def _save(fig, path: Path) -> None:
     plt.close(fig)
 
 
-def plot_fits(d: Discovery, data: Measurements, heldout: np.ndarray, path: Path) -> None:
-    """Predicted against measured, baseline and best extension, training and held-out rows."""
+def _pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+def verdict_lines(findings: dict) -> list[str]:
+    """What the run concluded, in plain lines: accepted mechanisms with their parameters, ambiguities,
+    unexplained trends, flagged baseline parameters. The terminal, ``report.md`` and the plots use these."""
+    lines = []
+    for c in findings["accepted"]:
+        params = ", ".join(f"{k} = {v['value']:.4g} ± {v['std_error']:.2g}" for k, v in c["parameters"].items())
+        lines.append(f"found: {c['name']} ({params}; step {c['step'] + 1}, ΔBIC {c['delta_bic']:+.1f}, held-out gain "
+                     f"{c['gain']:+.4f} ± {c['gain_std']:.4f}, removes {100 * c['explained']:.0f} % of the systematic "
+                     f"residual) — {c['source']}")
+    for c in findings["partial"]:
+        lines.append(f"partial: {c['name']} was accepted by the selection (ΔBIC {c['delta_bic']:+.1f}, removes "
+                     f"{100 * c['explained']:.0f} % of the systematic residual) but is not named as the cause: with it "
+                     f"the model still leaves {'; '.join(c['partial_because'])}")
+    if not findings["accepted"]:
+        lines.append("found: nothing")
+    for group in findings["ambiguities"]:
+        lines.append(f"ambiguous: {' or '.join(group)} explain the same residual about equally well (ΔBIC within "
+                     f"{BIC_MARGIN:g}); the data cannot tell them apart, so neither is named")
+    for u in findings["unexplained"]:
+        trend = f", Spearman {u['spearman']:+.2f}" if u["spearman"] is not None else ""
+        lines.append(f"unexplained: {u['text']} (shares of its systematic residual{trend}, lack-of-fit "
+                     f"p = {u['p_value']:.1g})")
+    base = findings["baseline"]
+    if base["unidentified"]:
+        lines.append(f"not identified by these data (classical model): {', '.join(base['unidentified'])}")
+    if base["at_bounds"]:
+        lines.append("at a bound (classical model): " + ", ".join(f"{k} ({v})" for k, v in base["at_bounds"].items()))
+    return lines
+
+
+def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndarray, path: Path) -> None:
+    """Predicted against measured, classical and final model, training and held-out rows."""
+    plt = _pyplot()
     models = [("classical", d.baseline.soil)]
-    if d.candidates:
-        best = d.found or d.candidates[0]
-        models.append((f"+ {best.extension.name}", best.fit.soil))
+    if findings["final"]["mechanisms"]:
+        models.append(("+ " + " + ".join(findings["final"]["mechanisms"]), d.final.soil))
     preds = [(label, model_responses(soil, data)) for label, soil in models]
     fig, axes = plt.subplots(1, len(d.responses), figsize=(4.2 * len(d.responses), 4), squeeze=False)
     for ax, q in zip(axes[0], d.responses):
@@ -45,110 +84,139 @@ def plot_fits(d: Discovery, data: Measurements, heldout: np.ndarray, path: Path)
         ax.set_xlabel(f"measured {q.replace('_', ' ')} [{unit}]")
         ax.set_ylabel(f"model [{unit}]")
     axes[0][0].legend(fontsize=7)
+    fig.suptitle("found: " + (", ".join(findings["found"]) or "nothing"), fontsize=10)
     fig.tight_layout()
     _save(fig, path)
 
 
-def plot_residuals(d: Discovery, data: Measurements, path: Path) -> None:
-    """Classical-model residuals against the condition with the strongest trend, per response."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    pred = model_responses(d.baseline.soil, data)
+def plot_residuals(findings: dict, d: Discovery, data: Measurements, path: Path) -> None:
+    """Final-model residuals against the condition that carries most of each response's remaining trend."""
+    plt = _pyplot()
+    pred = model_responses(d.final.soil, data)
+    unexplained = {u["response"]: u for u in findings["unexplained"]}
     fig, axes = plt.subplots(1, len(d.responses), figsize=(4.2 * len(d.responses), 3.6), squeeze=False)
     for ax, q in zip(axes[0], d.responses):
         trend = next((t for t in d.trends if t["response"] == q), None)
-        cond = trend["condition"] if trend else "slip"
+        cond = unexplained[q]["condition"] if q in unexplained else (trend["condition"] if trend else "slip")
         x = np.asarray(getattr(data, cond), float)
         unit, k = UNITS[q]
-        groups = np.unique(data.group)
-        for g in groups:
+        for g in np.unique(data.group):
             rows = data.group == g
             ax.scatter(x[rows], k * (pred[q][rows] - data.responses[q][rows]), s=14, label=str(g))
         ax.axhline(0, color="0.5", lw=0.8)
         ax.set_xlabel(cond.replace("_", " "))
         ax.set_ylabel(f"model - measured, {q.replace('_', ' ')} [{unit}]")
-        if trend:
-            ax.set_title(f"Spearman {trend['spearman']:+.2f} (p = {trend['p_value']:.1g})", fontsize=9)
+        ax.set_title(f"unexplained ({100 * unexplained[q]['share']:.0f} %)" if q in unexplained else "no systematic "
+                     "residual left", fontsize=9)
     if len(np.unique(data.group)) > 1:
         axes[0][0].legend(fontsize=7)
+    fig.suptitle("residuals of the final model (" + (" + ".join(["classical"] + findings["final"]["mechanisms"])) + ")",
+                 fontsize=10)
     fig.tight_layout()
     _save(fig, path)
 
 
-def plot_candidates(d: Discovery, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 3.6))
-    names = [c.extension.name for c in d.candidates]
-    gains = [c.gain for c in d.candidates]
-    errs = [c.gain_std for c in d.candidates]
-    colors = ["C2" if c.found else "0.6" for c in d.candidates]
-    ax.bar(range(len(names)), gains, yerr=errs, capsize=3, color=colors)
-    ax.axhline(0, color="0.4", lw=0.8)
-    ax.set_xticks(range(len(names)), names, rotation=25, ha="right")
-    ax.set_ylabel("held-out RMSE gain (normalised)")
-    ax.set_title("Candidate mechanisms (green: found)")
+def plot_candidates(findings: dict, path: Path) -> None:
+    """ΔBIC of every candidate at every selection step: green named, cyan accepted but partial, orange
+    ambiguous, grey not passed."""
+    plt = _pyplot()
+    steps = findings["steps"]
+    fig, axes = plt.subplots(1, len(steps), figsize=(6.5 * len(steps), 3.8), squeeze=False)
+    for ax, s in zip(axes[0], steps):
+        names = [c["name"] for c in s["candidates"]]
+        dbic = [c["delta_bic"] for c in s["candidates"]]
+        colors = ["C2" if c["named"] else "C9" if c["accepted"] else "C1" if c["name"] in s["ambiguity"] else "0.6"
+                  for c in s["candidates"]]
+        ax.bar(range(len(names)), dbic, color=colors)
+        ax.axhline(-BIC_MARGIN, color="0.4", lw=0.8, ls="--")
+        ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=7)
+        ax.set_ylabel("ΔBIC against the current model")
+        ax.set_title(f"step {s['step'] + 1}: on {' + '.join(['classical'] + s['model'])}", fontsize=9)
+    fig.suptitle("found: " + (", ".join(findings["found"]) or "nothing")
+                 + "".join(f"; ambiguous: {' or '.join(g)}" for g in findings["ambiguities"])
+                 + (f"; unexplained: {len(findings['unexplained'])} trend(s)" if findings["unexplained"] else ""),
+                 fontsize=10)
     fig.tight_layout()
     _save(fig, path)
+
+
+def _parameter_rows(table: list[dict]) -> list[str]:
+    out = ["| parameter | value | std. error | range | at a bound | identified |", "|---|---|---|---|---|---|"]
+    for r in table:
+        out.append(f"| {r['name']} | {r['value']:.4g} {r['unit'] if r['unit'] != '-' else ''} | {r['std_error']:.2g} | "
+                   f"{r['lower']:g} – {r['upper']:g} | {r['at_bound'] or 'no'} | {'yes' if r['identified'] else '**no**'} |")
+    return out
 
 
 def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str | Path, *, title: str,
-                 command: str = "", excluded: str = "") -> tuple[Path, Path, dict]:
+                 command: str = "", excluded: str = "", extra: dict | None = None) -> tuple[Path, Path, dict]:
     """Write ``report.md``, ``findings.json`` and the figures to ``out``; returns the two paths and the
-    findings (the JSON's content)."""
+    findings (the JSON's content). ``extra``: more findings (``test``: the model on a separate test set)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    plot_fits(d, data, heldout, out / "fits.png")
-    plot_residuals(d, data, out / "residuals.png")
-    if d.candidates:
-        plot_candidates(d, out / "candidates.png")
-    f = d.found
     findings = {"title": title, "data": data.name, "rows": len(data), "notes": data.notes, "command": command,
-                "excluded": excluded, **d.to_dict(), "provenance": provenance()}
+                "excluded": excluded, **d.to_dict(), **(extra or {}), "provenance": provenance()}
+    plot_fits(findings, d, data, heldout, out / "fits.png")
+    plot_residuals(findings, d, data, out / "residuals.png")
+    if findings["steps"]:
+        plot_candidates(findings, out / "candidates.png")
+    base = findings["baseline"]
     lines = [f"# {title}", "", f"Data: `{data.name}` ({len(data)} conditions; {data.notes}).",
              f"Fitted responses: {', '.join(d.responses)}; {d.n_train} training and {d.n_heldout} held-out "
-             "conditions.", ""]
+             "conditions; residuals normalised by the training data's spread.", ""]
     if excluded:
         lines += [f"Excluded: {excluded}", ""]
     if command:
         lines += ["Reproduce: `" + command + "`", ""]
-    lines += ["## What the classical model gets wrong", "",
-              f"Classical model (Wong–Reece, Janosi–Hanamoto, lateral shear; {', '.join(d.baseline.free)} "
-              f"fitted): normalised RMSE {d.baseline.rmse:.3f} on training, {d.baseline_heldout_rmse:.3f} held out.",
-              "", "Strongest residual trends (Spearman rank correlation with a condition):", "",
-              "| response | condition | Spearman | p |", "|---|---|---|---|"]
+    lines += ["## Verdict", ""] + [f"- {v}" for v in verdict_lines(findings)]
+    lines += ["", f"Held-out RMSE (normalised): classical {base['heldout_rmse']:.3f}, final model "
+              f"{findings['final']['heldout_rmse']:.3f}; the final model removes "
+              f"{100 * findings['final']['explained_share']:.0f} % of the classical model's systematic residual.", "",
+              "## The classical model, calibrated", "",
+              f"Wong–Reece normal stress with Reece's gravity-explicit pressure, Janosi–Hanamoto shear along and across "
+              f"the wheel, sinkage from vertical equilibrium; training RMSE {base['train_rmse']:.3f}. Standard errors "
+              "from the Fisher information; *identified: no* means the data do not constrain the parameter "
+              "(its ±2σ interval spans its whole range).", ""]
+    lines += _parameter_rows(base["parameter_table"])
+    lines += ["", "## What it gets wrong", "", "Strongest residual trends (Spearman rank correlation with a condition, "
+              "training rows):", "", "| response | condition | Spearman | p |", "|---|---|---|---|"]
     lines += [f"| {t['response']} | {t['condition']} | {t['spearman']:+.2f} | {t['p_value']:.2g} |" for t in d.trends[:6]]
-    lines += ["", "![](residuals.png)", "", "## Candidate causes", "",
-              "| mechanism | source | parameters | held-out gain | ΔBIC | effect | found |", "|---|---|---|---|---|---|---|"]
-    for c in d.candidates:
-        params = ", ".join(f"{k} = {v:.3g}" for k, v in c.to_dict()["parameters"].items())
-        source = c.extension.source.replace("|", "\\|")  # a pipe would split the table cell
-        lines.append(f"| {c.extension.name} | {source} | {params} | {c.gain:+.4f} ± {c.gain_std:.4f} | "
-                     f"{c.delta_bic:+.1f} | {c.effect:.3f} | {'**yes**' if c.found else 'no'} |")
-    at_bound = [f"{c.extension.name}: {p.name} = {c.fit.free[p.name]:.3g}" for c in d.candidates for p in c.extension.parameters
-                if min(abs(c.fit.free[p.name] - p.lower), abs(c.fit.free[p.name] - p.upper)) < 1e-6 * (p.upper - p.lower)
-                and c.effect > 1e-6]
-    if at_bound:
-        lines += ["", "At a bound of their range (the mechanism takes all it may; the misfit it addresses may be larger "
-                  "than it can explain): " + "; ".join(at_bound)]
+    lines += ["", "Lack of fit (quadratic regression of the residual on the conditions; p of its F-test), classical "
+              "→ final model:", "", "| response | classical p | final p |", "|---|---|---|"]
+    lof = findings["lack_of_fit"]
+    lines += [f"| {q} | {lof['baseline'][q]['p_value']:.2g} | {lof['final'][q]['p_value']:.2g} |" for q in d.responses]
+    lines += ["", "![](residuals.png)", "", "## Forward selection", "",
+              f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out gain exceeds "
+              f"{GAIN_SIGMAS:g} bootstrap standard deviations, its parameter is inside its physical range and of the "
+              f"mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of the systematic residual.", ""]
+    for s in findings["steps"]:
+        lines += [f"### Step {s['step'] + 1}: on {' + '.join(['classical'] + s['model'])}", "",
+                  "| mechanism | parameters | held-out gain | ΔBIC | removes | verdict |", "|---|---|---|---|---|---|"]
+        for c in s["candidates"]:
+            params = ", ".join(f"{k} = {v['value']:.3g}" for k, v in c["parameters"].items())
+            verdict = ("**named**" if c["named"] else "accepted, partial" if c["accepted"] else "ambiguous" if c["name"] in s["ambiguity"]
+                       else "passes" if c["passes"] else "; ".join(c["why_not"]).replace("|", "\\|"))
+            lines.append(f"| {c['name']} | {params} | {c['gain']:+.4f} ± {c['gain_std']:.4f} | {c['delta_bic']:+.1f} | "
+                         f"{100 * c['explained']:.0f} % | {verdict} |")
+        lines.append("")
+    if findings["steps"]:
+        lines += ["![](candidates.png)", ""]
     if d.skipped:
-        lines += ["", "Not tried (the data cannot show them): " + ", ".join(f"{k} ({v})" for k, v in d.skipped.items())]
-    lines += ["", "![](candidates.png)" if d.candidates else "", "", "## Finding", ""]
-    if f:
-        gain_pct = 100.0 * f.gain / d.baseline_heldout_rmse
-        lines += [f"**{f.extension.name}**: {f.extension.mechanism} ({f.extension.source}). Held-out RMSE "
-                  f"{d.baseline_heldout_rmse:.3f} → {f.heldout_rmse:.3f} ({gain_pct:.0f} % lower, gain "
-                  f"{f.gain:.4f} ± {f.gain_std:.4f}); ΔBIC {f.delta_bic:+.1f}."]
-    else:
-        lines += ["No mechanism earns its parameters here: none lowers BIC by more than 10 with a held-out gain "
-                  "beyond two bootstrap standard deviations."]
-    lines += ["", "![](fits.png)", ""]
+        lines += ["Not tried (the data cannot show them): " + ", ".join(f"{k} ({v})" for k, v in d.skipped.items()), ""]
+    if "test" in findings:
+        t = findings["test"]
+        lines += [f"## On the test set `{t['data']}`", "",
+                  f"The model fitted above predicts {t['rows']} rows it never saw (RMSE normalised by the training "
+                  f"spread): classical {t['classical_nrmse']:.3f}, final {t['final_nrmse']:.3f}, gain "
+                  f"{t['gain']:+.3f} ± {t['gain_std']:.3f}.", "", "| response | classical | final |", "|---|---|---|"]
+        lines += [f"| {q} | {v['classical_nrmse']:.3f} | {v['final_nrmse']:.3f} |" for q, v in t["responses"].items()]
+        lines.append("")
+    if findings["final"]["mechanisms"]:
+        lines += ["## The final model", "", f"Classical + {' + '.join(findings['final']['mechanisms'])}, calibrated "
+                  "together:", ""]
+        lines += _parameter_rows(findings["final"]["parameter_table"]) + [""]
+    lines += ["![](fits.png)", "", "The calibrated model (every parameter, the training rows) is in `model.json`; "
+              "`wheelsoil predict model.json DATA` predicts new data with it.", ""]
     md, js = out / "report.md", out / "findings.json"
     write_markdown_and_json(md, "\n".join(lines), js, findings, default=float)
     return md, js, findings

@@ -35,12 +35,44 @@ HIDDEN_RANGES = {
     "gravity_cohesion": {"cohesion_gravity_exponent": (1.0, 2.0)},
     "bulldozing": {"bulldozing_scale": (0.15, 0.4)},
     "multipass": {"multipass_k2": (0.1, 0.3)},
+    "gravity_pressure": {"kphi_gravity_exponent": (0.5, 1.0)},
+    "gravity_soil_flow": {"soil_flow_gravity": (0.3, 0.6)},
+}
+
+#: Effects the catalogue does not hold (the workflow must not give them a catalogue name): each a soil parameter
+#: that varies with a test condition in a way no extension models, with the range its strength is drawn from.
+#: ``field``: the SoilParameters field it changes; ``law(value, strength, cond)``: the field's value per row.
+OUT_OF_CATALOGUE = {
+    "friction_gravity": {
+        "description": "internal friction angle rising at low gravity, phi + d (1 - g / 9.81) (a gravity effect "
+                       "that acts through neither cohesion, pressure modulus nor soil flow)",
+        "field": "friction_angle", "range": (4.0, 8.0),
+        "law": lambda v, d, c: v + d * (1.0 - c["gravity"] / EARTH_GRAVITY)},
+    "shear_modulus_load": {
+        "description": "shear deformation modulus growing with the load, K (W / 90 N)^m",
+        "field": "shear_modulus_x", "range": (0.8, 1.5),
+        "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
+    "cohesion_slip_softening": {
+        "description": "cohesion lost as the soil is sheared, c (1 - s i) (strain softening)",
+        "field": "cohesion", "range": (0.7, 0.95),
+        "law": lambda v, s, c: v * (1.0 - s * c["slip"])},
+    "friction_steering": {
+        "description": "friction angle falling with the slip angle, phi - d sin|beta| (soil disturbed sideways)",
+        "field": "friction_angle", "range": (8.0, 14.0),
+        "law": lambda v, d, c: v - d * np.sin(np.radians(np.abs(c["slip_angle"])))},
+    "density_load": {
+        "description": "bulk density of the soil under the wheel rising with the load, rho (W / 90 N)^m "
+                       "(compaction under the wheel's own pressure bulb)",
+        "field": "density", "range": (0.3, 0.6),
+        "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
 }
 
 
-def conditions(slips=(0.05, 0.15, 0.3, 0.45, 0.6, 0.75), slip_angles=(0.0, 10.0, 20.0, 30.0),
-               loads=(60.0, 120.0), gravities=(EARTH_GRAVITY, 1.62), passes=(1, 2, 3)):
-    """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2]), each run on
+def conditions(slips=(0.05, 0.2, 0.35, 0.5, 0.7), slip_angles=(0.0, 10.0, 20.0, 30.0),
+               loads=(60.0, 120.0), gravities=(EARTH_GRAVITY, 3.71, 1.62), passes=(1, 2, 3)):
+    """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2]: Earth, Mars and
+    Moon, the three levels of seed 000's flights; three are needed to tell a gravity exponent of the pressure
+    modulus from the split between k'_c and k'_phi), each run on
     one of ``passes`` (the wheel's pass number over the same soil). The pass number cycles with the sum of the
     other factors' level indices, a balanced design in which it is not aliased with any one of them, so that
     adding it costs no extra conditions."""
@@ -49,6 +81,13 @@ def conditions(slips=(0.05, 0.15, 0.3, 0.45, 0.6, 0.75), slip_angles=(0.0, 10.0,
                                   indexing="ij")).reshape(4, -1).sum(axis=0)
     n_p = np.asarray(passes, float)[levels % len(passes)]
     return {"slip": grid[0], "slip_angle": grid[1], "load": grid[2], "gravity": grid[3], "passes": n_p}
+
+
+def draw_out_of_catalogue(rng: np.random.Generator, names=None) -> tuple[str, float]:
+    """An effect of :data:`OUT_OF_CATALOGUE` (uniformly among ``names``, default all) and its strength."""
+    names = list(OUT_OF_CATALOGUE if names is None else names)
+    name = names[int(rng.integers(len(names)))]
+    return name, float(rng.uniform(*OUT_OF_CATALOGUE[name]["range"]))
 
 
 def draw_hidden_effect(rng: np.random.Generator, names=None) -> tuple[str | None, dict]:
@@ -60,15 +99,39 @@ def draw_hidden_effect(rng: np.random.Generator, names=None) -> tuple[str | None
     return name, {k: float(rng.uniform(*bounds)) for k, bounds in HIDDEN_RANGES[name].items()}
 
 
+def _predict_with_effect(truth: SoilParameters, wheel: RigidWheel, cond: dict, effect: tuple | None) -> dict:
+    """:func:`predict` at every condition; ``effect`` = (name, strength) of :data:`OUT_OF_CATALOGUE` makes one soil
+    field vary with the conditions (rows grouped by its value, each group predicted with its own soil)."""
+    if effect is None:
+        return predict(truth, wheel, **cond)
+    name, strength = effect
+    spec = OUT_OF_CATALOGUE[name]
+    n = np.asarray(cond["slip"]).size
+    arrays = {k: np.broadcast_to(np.asarray(v, float), (n,)) for k, v in cond.items()}
+    values = spec["law"](getattr(truth, spec["field"]), strength, arrays)
+    values = np.broadcast_to(np.asarray(values, float), (n,))
+    out = {}
+    for v in np.unique(values):
+        rows = values == v
+        changes = {spec["field"]: float(v)}
+        if spec["field"] == "shear_modulus_x":
+            changes["shear_modulus_y"] = float(v)
+        part = predict(replace(truth, **changes), wheel, **{k: a[rows] for k, a in arrays.items()})
+        for q, a in part.items():
+            out.setdefault(q, np.zeros(n, np.asarray(a).dtype))[rows] = a
+    return out
+
+
 def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: SoilParameters = TRUE_SOIL,
                            wheel: RigidWheel = TEST_WHEEL, cond: dict | None = None, noise: float = 0.03,
-                           relative_noise: float = 0.02) -> Measurements:
+                           relative_noise: float = 0.02, effect: tuple | None = None) -> Measurements:
     """Measurements from ``soil`` with the ``hidden`` parameters changed, plus Gaussian noise of ``noise``
     times each response's spread and ``relative_noise`` times its value (the scatter of repeated rig
-    tests)."""
+    tests: heteroscedastic, larger where the response is larger). ``effect`` = (name, strength) adds an effect
+    of :data:`OUT_OF_CATALOGUE`."""
     cond = cond or conditions()
     truth = replace(soil, **hidden)
-    out = predict(truth, wheel, **cond)
+    out = _predict_with_effect(truth, wheel, cond, effect)
     n = out["sinkage"].size
     responses = {}
     for q in ("drawbar_pull", "lateral_force", "sinkage", "torque"):
@@ -81,7 +144,8 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
         load=np.asarray(cond["load"], float), gravity=np.asarray(cond["gravity"], float),
         radius=full(wheel.radius), width=full(wheel.width), grouser_height=full(wheel.grouser_height),
         grouser_count=full(wheel.grouser_count), group=np.full(n, "synthetic"), responses=responses,
-        notes=f"hidden: {hidden or 'nothing'}", passes=np.asarray(cond.get("passes", np.ones(n)), float),
+        notes=f"hidden: {hidden or 'nothing'}{f'; out of catalogue: {effect[0]} {effect[1]:.3g}' if effect else ''}",
+        passes=np.asarray(cond.get("passes", np.ones(n)), float),
     )
 
 
@@ -126,13 +190,22 @@ HIDDEN_OSCILLATIONS = {
 }
 #: Stiffness peaks per turn of the synthetic flexible wheel (the ExoMars wheel's six, seed 000).
 SYNTHETIC_SPOKES = 6
+#: A periodic effect outside the catalogue: an oscillation at a count per turn the declared wheel does not have
+#: (neither its grousers nor its spokes), with its amplitude as a fraction of the median steady value.
+UNDECLARED_COUNT = {"count": (8, 11), "amplitude": (0.05, 0.12)}
 
 
-def oscillation_conditions(slips=(0.1, 0.25, 0.4, 0.55), loads=(40.0, 80.0, 160.0), omegas=(1.5, 2.0, 2.5)):
+def oscillation_conditions(slips=(0.1, 0.25, 0.4, 0.55), loads=(40.0, 80.0, 160.0), omegas=(1.5, 2.0, 2.5),
+                           carriage_speed: float | None = None, radius: float = TEST_WHEEL.radius):
     """Runs for a periodic set: every slip at every load (a load is a held-out group), the wheel speed cycling
-    through ``omegas`` [rad/s] so that a counting law can be told from a constant frequency."""
+    through ``omegas`` [rad/s] so that a counting law can be told from a constant frequency; or, with
+    ``carriage_speed`` [m/s], the wheel speed a rig at that constant carriage speed sets, v / (r (1 - i)), which
+    ties it to the slip (the confound :func:`~wheelsoil.validation.periodic.speed_slip_confound` reports)."""
     slip, load = (a.ravel() for a in np.meshgrid(slips, loads, indexing="ij"))
-    omega = np.array([omegas[k % len(omegas)] for k in range(slip.size)], float)
+    if carriage_speed is not None:
+        omega = carriage_speed / (radius * (1.0 - slip))
+    else:
+        omega = np.array([omegas[k % len(omegas)] for k in range(slip.size)], float)
     return {"slip": slip, "slip_angle": np.zeros(slip.size), "load": load, "gravity": np.full(slip.size, EARTH_GRAVITY),
             "omega": omega}
 
@@ -168,6 +241,10 @@ def synthetic_oscillation_series(hidden: str | None, params: dict, rng: np.rando
         for k in range(1, coef.shape[0]):
             weight = 1.0 if 2 * k == values.shape[0] else 2.0
             signal += weight * np.real(coef[k][:, None] * np.exp(1j * k * angle))
+    elif hidden == "undeclared_count":
+        amp = params["amplitude"] * float(np.median(np.abs(steady)))
+        angle = int(params["count"]) * cond["omega"][:, None] * t[None, :] + rng.uniform(0, 2 * np.pi, n)[:, None]
+        signal = amp * np.sin(angle)
     elif hidden is None:
         signal = np.zeros((n, t.size))
     else:

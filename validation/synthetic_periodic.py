@@ -61,7 +61,10 @@ def synthetic_periodic_report(hidden: str | None = None, *, seed: int = 0, repor
         lines += [f"| {k} | {v['rms_relative_error']:.3f} | {v['bic']:.1f} | "
                   + ", ".join(f"{p} = {x:.3g}" for p, x in v["parameters"].items()) + " |" for k, v in law["laws"].items()]
     lines += ([""] if law["laws"] else []) + [f"Found: **{law['found']}**." if law["found"] else
-                                              f"No law found ({law['significant_runs']} significant runs)."]
+                                              f"No law found ({law['significant_runs']} significant runs)"
+                                              + (f": {law['note']}." if "note" in law else ".")]
+    if "confound" in law:
+        lines += ["", f"Confound: {law['confound']}."]
     amp = found["amplitude"]
     lines += ["", "## Amplitude mechanism", ""]
     if amp is None:

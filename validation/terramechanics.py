@@ -86,6 +86,12 @@ class SoilParameters:
         (:func:`bulldozing_force`); 0 leaves it out, as seed 003 does (no bulldozed soil seen in MER drives).
     multipass_k2: compaction per earlier pass: on pass n_p the soil's density and cohesion are 1 + k2 (n_p - 1)
         times the undisturbed soil's (seed 003 eq. 23 with k1 = 1 - k2); 0: every pass meets undisturbed soil.
+    kphi_gravity_exponent: epsilon of a frictional pressure modulus that does not scale fully with gravity,
+        rho g b k'_phi (g / 9.81)^(-epsilon): 0 is Reece's gravity-explicit form (seed 000 eq. 3), 1 the constant
+        K_phi of seed 000 ref. [32] (sinkage independent of gravity at equal load, as Kobayashi et al. observed).
+    soil_flow_gravity: soil flow that grows at lower gravity, eta(g) = soil_flow + soil_flow_gravity (1 - g / 9.81)
+        (seed 000 sec. 3.3: the soil's tangential velocity under the rim rises as gravity falls; eq. 8);
+        eta is held to [0, 0.95]. 0: the soil flow does not depend on gravity.
     """
 
     density: float = 1600.0
@@ -108,6 +114,8 @@ class SoilParameters:
     cohesion_gravity_exponent: float = 0.0
     bulldozing_scale: float = 0.0
     multipass_k2: float = 0.0
+    kphi_gravity_exponent: float = 0.0
+    soil_flow_gravity: float = 0.0
 
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
@@ -122,8 +130,9 @@ class SoilParameters:
             raise WheelsoilInputError(f"soil_flow = {self.soil_flow!r} is out of range: allowed 0 <= soil_flow < 1")
         if not (np.isfinite(self.radius_scale) and self.radius_scale >= 1.0):
             raise WheelsoilInputError(f"radius_scale = {self.radius_scale!r} is out of range: allowed radius_scale >= 1")
-        if not np.isfinite(self.cohesion_gravity_exponent):
-            raise WheelsoilInputError(f"cohesion_gravity_exponent = {self.cohesion_gravity_exponent!r} must be finite")
+        for key in ("cohesion_gravity_exponent", "kphi_gravity_exponent", "soil_flow_gravity"):
+            if not np.isfinite(getattr(self, key)):
+                raise WheelsoilInputError(f"{key} = {getattr(self, key)!r} must be finite")
         if not (np.isfinite(self.n1) and self.n0 + min(self.n1, 0.0) > 0.0):
             raise WheelsoilInputError(f"n1 = {self.n1!r} makes the sinkage exponent n0 + n1 |i| non-positive")
         if not (np.isfinite(self.a1) and np.isfinite(self.a2) and 0.0 <= self.a1 < 1.0 and 0.0 <= self.a1 + self.a2 <= 1.0):
@@ -217,7 +226,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     theta_m = np.clip(soil.a1 + soil.a2 * i, 0.0, 1.0) * theta_f
     theta_r = -soil.c3 * theta_f
     n = soil.n0 + soil.n1 * np.abs(i)
-    k_pressure = (cohesion * soil.kc_prime + density * g * b * soil.kphi_prime) * (r / b) ** n
+    kphi = soil.kphi_prime * (g / EARTH_GRAVITY) ** (-soil.kphi_gravity_exponent)  # 0: Reece (seed 000 eq. 3)
+    k_pressure = (cohesion * soil.kc_prime + density * g * b * kphi) * (r / b) ** n
 
     x, w = gauss_legendre()
     th_front, w_front = _gauss(theta_m, theta_f, x, w)
@@ -233,7 +243,9 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     tf = theta_f[:, None]
     driving = i[:, None] >= 0.0
     # seed 003 eq. 12 (driving / braking) and eq. 16
-    sweep = (tf - theta) * (1.0 - soil.soil_flow)  # seed 000 eq. 8: the soil under the rim moves with it
+    # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
+    eta = np.clip(soil.soil_flow + soil.soil_flow_gravity * (1.0 - g / EARTH_GRAVITY), 0.0, 0.95)
+    sweep = (tf - theta) * (1.0 - eta[:, None])
     jx = np.where(driving, r * (sweep - (1.0 - i[:, None]) * (np.sin(tf) - np.sin(theta))),
                   r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
     strength = cohesion[:, None] + sigma * np.tan(phi)

@@ -9,10 +9,12 @@ import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 
+from .calibration import normalised_residuals
+from .crossval import cross_validate, levels, write_cross_validation
 from .discovery import RESPONSES, discover, holdout_mask
-from .extensions import EXTENSIONS
 from .measured import Measurements, load_measurements, save_measurements
-from .report import write_report
+from .model_file import load_model, save_model, write_predictions
+from .report import verdict_lines, write_report
 from .synthetic import HIDDEN_RANGES, draw_hidden_effect, synthetic_measurements
 
 #: The model's steering-angle domain: lateral shear displacement ~ tan(beta).
@@ -67,9 +69,36 @@ def select_group(data: Measurements, group: str | None) -> Measurements:
     return data
 
 
+def _load_prepared(data_arg: str, group: str | None) -> tuple[Measurements, tuple, str]:
+    return prepare(select_group(load_measurements(data_arg), group))
+
+
+def test_errors(d, test: Measurements, *, seed: int = 0, bootstrap: int = 400) -> dict:
+    """The classical and the final model of ``d`` on a separate test set: per-response and overall RMSE
+    normalised by the training scales, and the final model's gain with its paired-bootstrap spread."""
+    responses = [q for q in d.responses if np.isfinite(test.responses[q]).any()]
+    if not responses:
+        raise WheelsoilInputError(f"--test {test.name}: none of the fitted responses {list(d.responses)} is measured")
+    base = normalised_residuals(d.baseline.soil, test, responses, d.scales, split=True)
+    final = normalised_residuals(d.final.soil, test, responses, d.scales, split=True)
+    rms = lambda e: float(np.sqrt(np.mean(e ** 2)))  # noqa: E731
+    b, f = np.concatenate(list(base.values())), np.concatenate(list(final.values()))
+    idx = np.random.default_rng(seed).integers(0, b.size, size=(bootstrap, b.size))
+    diffs = np.sqrt(np.mean(b[idx] ** 2, axis=1)) - np.sqrt(np.mean(f[idx] ** 2, axis=1))
+    return {"data": test.name, "rows": len(test), "responses": {q: {"classical_nrmse": rms(base[q]),
+                                                                     "final_nrmse": rms(final[q])} for q in responses},
+            "classical_nrmse": rms(b), "final_nrmse": rms(f), "gain": rms(b) - rms(f), "gain_std": float(np.std(diffs))}
+
+
 def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
-             seed: int = 0, group: str | None = None, command: str = "") -> dict:
-    """Load (or synthesise) the data, run discovery, write the report; returns the findings dict."""
+             seed: int = 0, group: str | None = None, command: str = "", test: str | None = None) -> dict:
+    """Load (or synthesise) the data, run discovery, write the report and ``model.json``; with ``test``, also
+    predict that second dataset with the model fitted on the first. Returns the findings dict."""
+    test_data = None
+    if test is not None:  # read and check before any fitting
+        if test in ("synthetic", "synthetic-periodic"):
+            raise WheelsoilInputError(f"--test {test!r}: give a measured dataset (file or folder)")
+        test_data, _, _ = _load_prepared(test, group)
     if data_arg == "synthetic":
         rng = np.random.default_rng(seed)
         if hidden is None:
@@ -84,24 +113,45 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
         report.mkdir(parents=True, exist_ok=True)
         save_measurements(data, report / "synthetic_data.csv")
         title = "Validation on synthetic data (the hidden mechanism is revealed at the end)"
+        data = select_group(data, group)
+        data, default_responses, excluded = prepare(data)
     else:
         if hidden is not None:
             raise WheelsoilInputError("--hidden applies to 'synthetic' data only")
-        data = load_measurements(data_arg)
+        data, default_responses, excluded = _load_prepared(data_arg, group)
         title = f"Validation against {data.name}"
         name = params = None
-    data = select_group(data, group)
-    data, default_responses, excluded = prepare(data)
     mask = parse_holdout(holdout, data, seed)
     d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed)
-    md, _, findings = write_report(d, data, mask, report, title=title, command=command, excluded=excluded)
+    extra = {"test": test_errors(d, test_data, seed=seed)} if test_data is not None else {}
+    md, _, findings = write_report(d, data, mask, report, title=title, command=command, excluded=excluded, extra=extra)
+    save_model(report / "model.json", d, data.select(~mask), command=command)
     if data_arg == "synthetic":
         with open(md, "a") as fh:
             fh.write(f"\n## The hidden truth\n\nHidden: {name or 'nothing'} {params or ''}\n")
     findings["report"] = str(md)
+    findings["model"] = str(report / "model.json")
     if data_arg == "synthetic":
         findings["hidden"] = {"name": name, "parameters": params}
     return findings
+
+
+def cross_validate_command(data_arg: str, by: str, *, report: Path, responses=None, group: str | None = None,
+                           seed: int = 0, command: str = "", progress=None) -> dict:
+    """``wheelsoil validate DATA --cv CONDITION``: leave each level of CONDITION out in turn (:mod:`.crossval`)."""
+    data, default_responses, _ = _load_prepared(data_arg, group)
+    levels(data, by)  # refuse a bad condition before any fitting
+    cv = cross_validate(data, by, responses=responses or default_responses, seed=seed, progress=progress)
+    cv["report"] = str(write_cross_validation(cv, data, report, command=command))
+    return cv
+
+
+def predict_command(model_path: str, data_arg: str, *, out: Path, group: str | None = None) -> dict:
+    """``wheelsoil predict MODEL DATA``: the saved model's predictions and errors on DATA."""
+    model = load_model(model_path)
+    data, _, _ = _load_prepared(data_arg, group)
+    path, errors = write_predictions(model, data, out)
+    return {"predictions": str(path), "errors": errors, "mechanisms": model.mechanisms, "rows": len(data)}
 
 
 def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, responses=None, group: str | None = None,
@@ -136,16 +186,36 @@ def main_validate(args) -> int:
                           f"p = {t['p_value']:.1g})")
         console.print(f"wrote {f['report']}")
         return 0
+    if getattr(args, "cv", None):
+        def show(fold):
+            console.print(f"  held out {args.cv} = {fold['level']}: found {', '.join(fold['found']) or 'nothing'}; "
+                          f"classical {fold['classical_nrmse']:.3f} -> {fold['final_nrmse']:.3f} "
+                          f"(gain {fold['gain']:+.3f} +- {fold['gain_std']:.3f})", markup=False)
+
+        cv = cross_validate_command(args.data, args.cv, report=args.report, responses=args.responses,
+                                    group=args.group, seed=args.seed, command=command, progress=show)
+        console.print(f"wrote {cv['report']}")
+        return 0
     findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
-                        hidden=args.hidden, seed=args.seed, group=args.group, command=command)
+                        hidden=args.hidden, seed=args.seed, group=args.group, command=command,
+                        test=getattr(args, "test", None))
     base = findings["baseline"]
-    console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out)")
-    for c in findings["candidates"]:
-        console.print(f"  {c['name']:18s} gain {c['gain']:+.4f} +- {c['gain_std']:.4f}  dBIC {c['delta_bic']:+8.1f}"
-                      f"{'  FOUND' if c['found'] else ''}")
-    f = findings["found"]
-    console.print(f"found: [bold]{f['name']}[/bold] ({EXTENSIONS[f['name']].source})" if f else "found: nothing")
+    console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out); "
+                  f"final model: {findings['final']['heldout_rmse']:.3f} (held out)")
+    for s in findings["steps"]:
+        console.print(f"step {s['step'] + 1} (on {' + '.join(['classical'] + s['model'])}):")
+        for c in s["candidates"]:
+            tag = "  ACCEPTED" if c["accepted"] else "  ambiguous" if c["name"] in s["ambiguity"] else ""
+            console.print(f"  {c['name']:18s} gain {c['gain']:+.4f} +- {c['gain_std']:.4f}  dBIC {c['delta_bic']:+8.1f}"
+                          f"  removes {100 * c['explained']:3.0f} %{tag}")
+    for line in verdict_lines(findings):
+        console.print(line, markup=False, highlight=False)
+    if "test" in findings:
+        t = findings["test"]
+        console.print(f"test set {t['data']} ({t['rows']} rows): classical {t['classical_nrmse']:.3f} -> final "
+                      f"{t['final_nrmse']:.3f} (gain {t['gain']:+.3f} +- {t['gain_std']:.3f})", markup=False)
     if "hidden" in findings:
         console.print(f"hidden: {findings['hidden']['name']} {findings['hidden']['parameters']}")
-    console.print(f"wrote {findings['report']} and {Path(findings['report']).with_name('findings.json')}")
+    console.print(f"wrote {findings['report']}, {Path(findings['report']).with_name('findings.json')} and "
+                  f"{findings['model']}")
     return 0

@@ -1,0 +1,84 @@
+"""Leave-one-condition-out cross-validation of the discovery workflow.
+
+Each level of a condition (a steering angle, a load, a gravity level, a wheel) is held out in turn; the whole
+workflow (classical calibration, forward selection) runs on the other levels, and the held-out level is predicted
+by the classical and by the final model. The gain per held-out level shows whether a finding carries beyond the
+conditions it was fitted on, and the mechanisms found per fold whether the finding itself is stable.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.provenance import provenance, write_markdown_and_json
+
+from .calibration import normalised_residuals
+from .discovery import discover
+from .measured import Measurements
+
+CV_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height", "group")
+
+
+def levels(data: Measurements, by: str) -> list:
+    """The distinct levels of condition ``by`` in ``data`` (sorted)."""
+    if by not in CV_CONDITIONS:
+        raise WheelsoilInputError(f"--cv {by!r}: choose a condition from {list(CV_CONDITIONS)}")
+    values = np.asarray(getattr(data, by))
+    out = sorted(set(values.tolist()))
+    if len(out) < 2:
+        raise WheelsoilInputError(f"--cv {by}: the data hold a single level ({out[0]!r}); nothing to hold out")
+    return out
+
+
+def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, bootstrap: int = 400,
+                   progress=None) -> dict:
+    """Hold out each level of ``by`` in turn (see the module docstring). Returns a dict with one fold per level:
+    the mechanisms found, the classical and final model's normalised RMSE on the held-out level, the gain and its
+    bootstrap standard deviation."""
+    values = np.asarray(getattr(data, by))
+    folds = []
+    rng = np.random.default_rng(seed)
+    for level in levels(data, by):
+        mask = values == level
+        d = discover(data, responses=responses, heldout=mask, seed=seed, bootstrap=bootstrap)
+        test = data.select(mask)
+        base = normalised_residuals(d.baseline.soil, test, d.responses, d.scales)
+        final = normalised_residuals(d.final.soil, test, d.responses, d.scales)
+        idx = rng.integers(0, base.size, size=(bootstrap, base.size))
+        diffs = np.sqrt(np.mean(base[idx] ** 2, axis=1)) - np.sqrt(np.mean(final[idx] ** 2, axis=1))
+        b, f = float(np.sqrt(np.mean(base ** 2))), float(np.sqrt(np.mean(final ** 2)))
+        folds.append({"level": level if isinstance(level, str) else float(level), "rows": int(mask.sum()),
+                      "found": d.found, "ambiguities": d.ambiguities,
+                      "unexplained": [u["text"] for u in d.unexplained], "classical_nrmse": b, "final_nrmse": f,
+                      "gain": b - f, "gain_std": float(np.std(diffs))})
+        if progress:
+            progress(folds[-1])
+    names = sorted({n for fold in folds for n in fold["found"]})
+    return {"condition": by, "folds": folds, "found_in": {n: sum(n in f["found"] for f in folds) for n in names}}
+
+
+def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "") -> Path:
+    """``crossval.md`` and ``crossval.json`` in ``out``."""
+    out = Path(out)
+    by = cv["condition"]
+    lines = [f"# Leave-one-{by.replace('_', '-')}-out cross-validation: {data.name}", "",
+             f"Each level of {by.replace('_', ' ')} is held out in turn; the classical model is calibrated and the "
+             "mechanisms are selected on the other levels, then both models predict the held-out level (RMSE "
+             "normalised by the training data's spread).", ""]
+    if command:
+        lines += ["Reproduce: `" + command + "`", ""]
+    lines += [f"| held-out {by} | rows | found on the rest | classical | final | gain |", "|---|---|---|---|---|---|"]
+    for f in cv["folds"]:
+        found = ", ".join(f["found"]) or "nothing"
+        if f["ambiguities"]:
+            found += "; ambiguous: " + "; ".join(" or ".join(g) for g in f["ambiguities"])
+        lines.append(f"| {f['level']} | {f['rows']} | {found} | {f['classical_nrmse']:.3f} | {f['final_nrmse']:.3f} | "
+                     f"{f['gain']:+.3f} ± {f['gain_std']:.3f} |")
+    n = len(cv["folds"])
+    lines += ["", "Found in how many folds: " + (", ".join(f"{k} {v} of {n}" for k, v in cv["found_in"].items())
+                                                 or "nothing in any fold"), ""]
+    md = out / "crossval.md"
+    write_markdown_and_json(md, "\n".join(lines), out / "crossval.json", {**cv, "command": command,
+                                                                           "provenance": provenance()}, default=float)
+    return md

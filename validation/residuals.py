@@ -1,0 +1,130 @@
+"""What a calibrated model leaves in its residuals: trends against each condition, and how much of the misfit
+is systematic rather than noise.
+
+* :func:`residual_trends`: Spearman rank correlation of each response's residual with each condition that varies
+  (monotone trends; what a plot of residual against condition shows).
+* :func:`systematic_residual`: a lack-of-fit test that needs no replicate measurements. Each response's
+  normalised residual is regressed on a full quadratic in the conditions that vary (linear, square and pairwise
+  product terms of the standardised conditions). Under a model that is right up to independent noise the
+  regression explains only noise: its F statistic follows F(p, n - p - 1) (the regression F-test; Draper & Smith,
+  Applied Regression Analysis, sec. 2.8; Ramsey's RESET is the same idea with fitted values as regressors). The
+  sum of squares the regression explains beyond its noise expectation p s^2 is the *systematic residual*: the part
+  of the misfit a smooth function of the conditions would remove. A mechanism that is the cause of a misfit
+  removes it; one that only resembles it leaves part of it (:mod:`.discovery` uses both).
+* :func:`unexplained_trends`: for each response whose lack of fit is significant, the conditions whose terms carry
+  most of it (partial sums of squares), with their shares and the Spearman trend: "error trends with X".
+"""
+
+from itertools import combinations
+
+import numpy as np
+from scipy.stats import f as f_distribution
+from scipy.stats import spearmanr
+
+from .measured import Measurements
+
+CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height")
+#: Significance of a response's lack of fit, before the Bonferroni division by the number of responses.
+LACK_OF_FIT_ALPHA = 1e-3
+#: An unexplained trend names every condition whose terms carry at least this share of the response's
+#: systematic residual (shares overlap: a product term counts for both of its conditions).
+NAMED_SHARE = 0.3
+
+
+def residual_trends(residuals: dict[str, np.ndarray], data: Measurements, rows: dict[str, np.ndarray]) -> list[dict]:
+    """Spearman rank correlation of each response's residual with each condition variable that varies.
+
+    residuals: response -> residual at its measured rows; rows: response -> boolean mask of those rows."""
+    out = []
+    for q, res in residuals.items():
+        ok = rows[q]
+        for c in CONDITIONS:
+            x = np.asarray(getattr(data, c), float)[ok]
+            if x.size < 4 or np.ptp(x) == 0:
+                continue
+            rho, p = spearmanr(x, res)
+            out.append({"response": q, "condition": c, "spearman": float(rho), "p_value": float(p)})
+    return sorted(out, key=lambda r: r["p_value"])
+
+
+def _design(x: dict[str, np.ndarray]) -> tuple[np.ndarray, list[tuple[str, ...]]]:
+    """Quadratic design (without intercept) over the standardised columns of ``x``: each term names the
+    conditions it involves."""
+    cols, terms = [], []
+    z = {c: (v - v.mean()) / v.std() for c, v in x.items()}
+    for c, v in z.items():
+        cols.append(v)
+        terms.append((c,))
+        if np.unique(v).size > 2:  # a square of a two-level factor is the intercept again
+            cols.append(v * v - np.mean(v * v))
+            terms.append((c,))
+    for a, b in combinations(z, 2):
+        cols.append(z[a] * z[b] - np.mean(z[a] * z[b]))
+        terms.append((a, b))
+    return (np.column_stack(cols) if cols else np.zeros((len(next(iter(x.values()), [])), 0))), terms
+
+
+def _regress(design: np.ndarray, y: np.ndarray) -> tuple[float, float, int]:
+    """Sum of squares explained by ``design`` (centred y), residual sum of squares, rank."""
+    yc = y - y.mean()
+    if design.shape[1] == 0:
+        return 0.0, float(yc @ yc), 0
+    coef, _, rank, _ = np.linalg.lstsq(design - design.mean(axis=0), yc, rcond=1e-10)
+    fitted = (design - design.mean(axis=0)) @ coef
+    return float(fitted @ fitted), float((yc - fitted) @ (yc - fitted)), int(rank)
+
+
+def systematic_residual(residuals: dict[str, np.ndarray], data: Measurements, rows: dict[str, np.ndarray]) -> dict:
+    """Lack of fit per response (see the module docstring).
+
+    Returns {"responses": {q: {"ss_explained", "ss_noise", "systematic", "f", "p_value", "terms", "rows",
+    "by_condition": {c: partial systematic SS}}}, "systematic": total systematic SS (normalised units^2)}.
+    """
+    out, total = {}, 0.0
+    for q, res in residuals.items():
+        ok = rows[q]
+        x = {c: np.asarray(getattr(data, c), float)[ok] for c in CONDITIONS}
+        x = {c: v for c, v in x.items() if v.size > 1 and np.ptp(v) > 0}
+        design, terms = _design(x)
+        n = res.size
+        while design.shape[1] and n - design.shape[1] - 1 < 10:  # too few rows for the quadratic: fewer terms
+            design, terms = design[:, :-1], terms[:-1]
+        ss_reg, ss_res, p = _regress(design, res)
+        dof = max(n - p - 1, 1)
+        s2 = ss_res / dof
+        f = (ss_reg / p) / s2 if p and s2 > 0 else 0.0
+        p_value = float(f_distribution.sf(f, p, dof)) if p else 1.0
+        systematic = max(ss_reg - p * s2, 0.0)
+        by_condition = {}
+        for c in x:
+            keep = [j for j, t in enumerate(terms) if c not in t]
+            ss_without, _, p_without = _regress(design[:, keep], res)
+            by_condition[c] = max(ss_reg - ss_without - (p - p_without) * s2, 0.0)
+        out[q] = {"ss_explained": ss_reg, "ss_noise": p * s2, "systematic": systematic, "f": float(f),
+                  "p_value": p_value, "terms": p, "rows": n, "noise_variance": s2, "by_condition": by_condition}
+        total += systematic
+    return {"responses": out, "systematic": total}
+
+
+def unexplained_trends(lack: dict, trends: list[dict], *, alpha: float = LACK_OF_FIT_ALPHA) -> list[dict]:
+    """Responses whose residual still holds a significant systematic part (p below ``alpha`` / number of
+    responses): the condition carrying most of it, its share of that response's systematic residual, and the
+    Spearman trend of the residual with it."""
+    responses = lack["responses"]
+    cutoff = alpha / max(len(responses), 1)
+    out = []
+    for q, r in responses.items():
+        if r["p_value"] >= cutoff or r["systematic"] <= 0:
+            continue
+        parts = r["by_condition"]
+        ranked = sorted(parts, key=parts.get, reverse=True)
+        shares = {c: min(parts[c] / r["systematic"], 1.0) for c in ranked}
+        named = [c for c in ranked if shares[c] >= NAMED_SHARE] or ranked[:1]
+        cond = named[0] if named else None
+        trend = next((t for t in trends if t["response"] == q and t["condition"] == cond), None)
+        with_ = ", ".join(f"{c.replace('_', ' ')} ({100 * shares[c]:.0f} %)" for c in named)
+        out.append({"response": q, "condition": cond, "conditions": {c: float(shares[c]) for c in named},
+                    "share": float(shares[cond]) if cond else 0.0, "systematic": r["systematic"],
+                    "p_value": r["p_value"], "spearman": trend["spearman"] if trend else None,
+                    "text": f"error in {q.replace('_', ' ')} trends with {with_ or '?'}"})
+    return sorted(out, key=lambda u: -u["systematic"])
