@@ -410,6 +410,8 @@ def cmd_validate(args) -> int:
                           f"{r['cycles']:.1f} cycles{'  significant' if r['significant'] else ''}")
         for config, found in out["configurations"].items():
             verdict = found["found"] or found.get("note") or "none within tolerance"
+            if "unexplained" in found:
+                verdict += f"; unexplained: {found['unexplained']}"
             console.print(f"{config}: frequency law: {verdict} ({found['significant_runs']} significant runs)")
         console.print(f"wrote {out['report']}")
         return EXIT_OK

@@ -151,7 +151,13 @@ def test_a_candidate_passes_only_with_every_check():
 
     assert cand().passes and cand().reasons() == []
     assert not cand(delta_bic=-5.0).passes
-    assert not cand(gain=0.015).passes  # under two bootstrap standard deviations
+    assert not cand(gain=0.008).passes  # under one bootstrap standard deviation (GAIN_SIGMAS)
+    assert not cand(gain=-0.02, gain_std=0.001).passes
+    # a pair needs each member: one that adds nothing to the other alone is a passenger
+    pair = cand(partner=EXTENSIONS["soil_flow"], needs={"soil_flow": -30.0, "slip_sinkage": -12.0})
+    assert pair.passes and pair.names == ["slip_sinkage", "soil_flow"] and pair.name == "slip_sinkage + soil_flow"
+    passenger = cand(partner=EXTENSIONS["soil_flow"], needs={"soil_flow": -3.0, "slip_sinkage": -40.0})
+    assert not passenger.passes and "soil_flow adds ΔBIC -3.0" in passenger.reasons()[1]
     assert not cand(explained=0.3).passes
     assert not cand(problems=["n1 = 1.5 at its upper bound"]).passes
     assert "removes 30 %" in cand(explained=0.3).reasons()[0]

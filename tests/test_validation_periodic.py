@@ -213,3 +213,20 @@ def test_wheel_speed_tied_to_slip_is_reported_as_a_confound(count):
     out = explain_frequencies(runs, grousers=24, spokes=12)
     assert out["speed_slip_r2"] > 0.999 and "tied to the slip" in out["confound"]
     assert out["found"] == (None if count == 7 else "spoke_stiffness"), out
+    if count == 7:
+        assert "at 7 ± 0.00 per wheel turn" in out["unexplained"] and "12 spokes" in out["unexplained"]
+    else:
+        assert "unexplained" not in out
+
+
+def test_an_undeclared_count_per_turn_is_reported_unexplained():
+    """Nine peaks per turn on a wheel declaring 24 grousers and 12 spokes, at two wheel speeds: no law fits,
+    and the report says what the oscillation is (a steady count per turn) instead of naming nothing silently.
+    Frequencies that follow no count are described by their range."""
+    runs = [Run(w, s, _component(9 * w / (2 * np.pi))) for w in (1.0, 2.0) for s in (0.1, 0.3, 0.5)]
+    out = explain_frequencies(runs, grousers=24, spokes=12)
+    assert out["found"] is None and "at 9 ± 0.00 per wheel turn" in out["unexplained"], out
+    scattered = [Run(w, s, _component(f)) for w, s, f in [(1.0, 0.1, 1.3), (1.0, 0.5, 2.9), (2.0, 0.3, 1.1),
+                                                           (2.0, 0.6, 4.2)]]
+    out = explain_frequencies(scattered, grousers=24, spokes=12)
+    assert out["found"] is None and "1.1-4.2 Hz" in out["unexplained"], out

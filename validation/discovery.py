@@ -20,6 +20,13 @@ A candidate passes a step when
    resembles the cause takes part of the misfit and leaves the rest; this is what keeps an effect the catalogue
    does not hold from being given the nearest name.
 
+When no single candidate passes and the current model still leaves a significant systematic residual, the
+step looks one step ahead: every pair among the :data:`PAIR_POOL` best single fits is fitted together (from each
+member's own fit with the other's parameters mid-range). A pair passes the same four checks, and its evidence also
+needs each member: the pair's BIC must be lower by :data:`BIC_MARGIN` than each member's alone, so that no
+passenger rides along. Two mechanisms that act together (a gravity-scaled cohesion and a sidewall term both
+shaping lateral force at low gravity) can each fail alone and pass as a pair.
+
 Two candidates that both pass and whose BICs are within :data:`AMBIGUITY_MARGIN` explain the same residual about
 equally well: the model with both is fitted, and if the second adds nothing beyond the first (BIC not lower by
 :data:`BIC_MARGIN`, or its parameter at a bound) the step reports an **ambiguity** between them and selection stops
@@ -30,6 +37,7 @@ mechanism does not hold. Residuals are normalised per response by the training d
 """
 
 from dataclasses import dataclass, field, replace
+from itertools import combinations
 
 import numpy as np
 
@@ -49,12 +57,19 @@ from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
 from .terramechanics import SoilParameters
 
-__all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "RESPONSES", "Candidate",
+__all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "PAIR_POOL", "RESPONSES",
+           "Candidate",
            "Discovery", "Fit", "Step", "discover", "holdout_mask", "mechanism_effect", "model_responses",
            "normalised_residuals", "response_scales"]
 
 BIC_MARGIN = 10.0
-GAIN_SIGMAS = 2.0
+#: The held-out check guards against a fit that predicts worse than the model it extends; the evidence is BIC's.
+#: The held-out set is a third of the rows, so its bootstrap spread is wide: one standard deviation.
+GAIN_SIGMAS = 1.0
+#: When no single mechanism passes and a systematic residual remains, pairs among this many best single fits
+#: (by BIC) are fitted together: two mechanisms that act together can each fail alone (a forward-selection
+#: look-ahead of one step).
+PAIR_POOL = 6
 AMBIGUITY_MARGIN = 10.0
 #: Share of the current model's systematic residual an accepted mechanism must remove.
 MIN_EXPLAINED = 0.5
@@ -78,17 +93,18 @@ def holdout_mask(data: Measurements, *, fraction: float = 0.3, by: str | None = 
     return mask
 
 
-def mechanism_effect(soil: SoilParameters, extension: Extension, data: Measurements, responses, scales, *,
-                     by_response: bool = False):
-    """RMS over conditions and responses of what ``extension`` adds to the model ``soil`` (normalised); with
-    ``by_response`` a dict of the RMS per response.
+def mechanism_effect(soil: SoilParameters, extension: Extension | tuple[Extension, ...], data: Measurements,
+                     responses, scales, *, by_response: bool = False):
+    """RMS over conditions and responses of what ``extension`` (one or several together) adds to the model
+    ``soil`` (normalised); with ``by_response`` a dict of the RMS per response.
 
     Scale-type parameters (sidewall, grouser) multiply formulas that also hold cohesion and friction, so a
     fit may trade the scale against them; the mechanism's contribution to the responses is what the data
     fix, and what this measures.
     """
+    exts = extension if isinstance(extension, tuple) else (extension,)
     on = model_responses(soil, data)
-    off = model_responses(replace(soil, **extension.off), data)
+    off = model_responses(replace(soil, **{k: v for e in exts for k, v in e.off.items()}), data)
     parts = {q: (on[q] - off[q]) / scales[q] for q in responses}
     if by_response:
         return {q: float(np.sqrt(np.mean(v ** 2))) for q, v in parts.items()}
@@ -102,13 +118,14 @@ def _lack_of_fit(soil: SoilParameters, data: Measurements, responses, scales) ->
     return systematic_residual(res, data, rows), residual_trends(res, data, rows)
 
 
-def _parameter_problems(ext: Extension, fit: Fit) -> list[str]:
-    """Why the fitted parameters of ``ext`` are not a physical instance of the mechanism (empty: they are): a
+def _parameter_problems(exts: Extension | tuple[Extension, ...], fit: Fit) -> list[str]:
+    """Why the fitted parameters of ``exts`` are not a physical instance of the mechanism (empty: they are): a
     bound the data push against (:meth:`~.calibration.Fit.binding_bounds`; a saturating parameter resting on
     its search bound is a one-sided estimate, not a problem), or the opposite sign to the mechanism's."""
     problems = []
     binding = fit.binding_bounds()
-    for p in ext.parameters:
+    exts = exts if isinstance(exts, tuple) else (exts,)
+    for ext, p in ((e, p) for e in exts for p in e.parameters):
         v = fit.free[p.name]
         if p.name in binding:
             problems.append(f"{p.name} = {v:.4g} at its {binding[p.name]} bound, which the data push against")
@@ -138,6 +155,23 @@ class Candidate:
     #: accepted by the selection, but the final model still leaves a systematic residual in a response this
     #: mechanism moves: it explains part of the misfit and is not named as its cause
     partial: list[str] = field(default_factory=list)
+    #: a pair step (:data:`PAIR_POOL`): the second mechanism fitted together with ``extension``
+    partner: Extension | None = None
+    #: a pair's BIC against each member alone, by the member it adds ({b: joint - (current + a)}): each must
+    #: lower BIC by :data:`BIC_MARGIN`, or the pair holds a passenger
+    needs: dict = field(default_factory=dict)
+
+    @property
+    def extensions(self) -> tuple[Extension, ...]:
+        return (self.extension,) if self.partner is None else (self.extension, self.partner)
+
+    @property
+    def names(self) -> list[str]:
+        return [e.name for e in self.extensions]
+
+    @property
+    def name(self) -> str:
+        return " + ".join(self.names)
 
     def moves(self) -> list[str]:
         """The responses this mechanism changes by at least :data:`MOVES_RESPONSE` of their spread."""
@@ -145,7 +179,7 @@ class Candidate:
 
     @property
     def checks(self) -> dict[str, bool]:
-        return {"evidence": bool(self.delta_bic < -BIC_MARGIN),
+        return {"evidence": bool(self.delta_bic < -BIC_MARGIN and all(v < -BIC_MARGIN for v in self.needs.values())),
                 "prediction": bool(self.gain > 0 and self.gain > GAIN_SIGMAS * self.gain_std),
                 "physical_parameter": not self.problems,
                 "signature": bool(self.explained >= MIN_EXPLAINED)}
@@ -159,6 +193,7 @@ class Candidate:
         c, out = self.checks, []
         if not c["evidence"]:
             out.append(f"ΔBIC {self.delta_bic:+.1f} (needs < -{BIC_MARGIN:g})")
+            out += [f"{n} adds ΔBIC {v:+.1f} to the other alone" for n, v in self.needs.items() if v >= -BIC_MARGIN]
         if not c["prediction"]:
             out.append(f"held-out gain {self.gain:+.4f} ± {self.gain_std:.4f}")
         out += self.problems
@@ -168,15 +203,17 @@ class Candidate:
         return out
 
     def parameters(self) -> dict[str, float]:
-        return {p.name: self.fit.free[p.name] for p in self.extension.parameters}
+        return {p.name: self.fit.free[p.name] for e in self.extensions for p in e.parameters}
 
     def to_dict(self) -> dict:
         table = {r["name"]: r for r in self.fit.parameter_table()}
-        return {"name": self.extension.name, "mechanism": self.extension.mechanism, "source": self.extension.source,
-                "step": self.step,
+        return {"name": self.name, "names": self.names,
+                "mechanism": "; ".join(e.mechanism for e in self.extensions),
+                "source": "; ".join(e.source for e in self.extensions), "step": self.step,
                 "parameters": {p.name: {"value": table[p.name]["value"], "std_error": table[p.name]["std_error"],
                                         "unit": p.unit, "at_bound": table[p.name]["at_bound"]}
-                               for p in self.extension.parameters},
+                               for e in self.extensions for p in e.parameters},
+                "needs": self.needs,
                 "train_rmse": self.fit.rmse, "heldout_rmse": self.heldout_rmse, "gain": self.gain,
                 "gain_std": self.gain_std, "delta_bic": self.delta_bic, "effect": self.effect,
                 "explained": self.explained, "checks": self.checks, "passes": self.passes,
@@ -195,10 +232,13 @@ class Step:
     candidates: list[Candidate]
     accepted: str | None = None
     ambiguity: list[str] = field(default_factory=list)
+    #: a look-ahead step: its candidates are pairs of mechanisms fitted together
+    pairs: bool = False
 
     def to_dict(self) -> dict:
         return {"step": self.index, "model": list(self.model), "heldout_rmse": self.heldout_rmse,
                 "systematic_residual": self.systematic, "accepted": self.accepted, "ambiguity": self.ambiguity,
+                "pairs": self.pairs,
                 "candidates": [c.to_dict() for c in self.candidates]}
 
 
@@ -230,7 +270,7 @@ class Discovery:
     def found(self) -> list[str]:
         """Names of the mechanisms named as causes: accepted, and the final model leaves no systematic residual
         in a response they move."""
-        return [c.extension.name for c in self.accepted if not c.partial]
+        return [n for c in self.accepted if not c.partial for n in c.names]
 
     @property
     def partial(self) -> list[Candidate]:
@@ -265,7 +305,7 @@ class Discovery:
             "ambiguities": self.ambiguities,
             "unexplained": self.unexplained,
             "baseline": model(self.baseline, self.baseline_heldout_rmse),
-            "final": {"mechanisms": [c.extension.name for c in self.accepted], **model(self.final, self.final_heldout_rmse),
+            "final": {"mechanisms": [n for c in self.accepted for n in c.names], **model(self.final, self.final_heldout_rmse),
                       "explained_share": self.explained_share()},
             "steps": [s.to_dict() for s in self.steps],
             "residual_trends": self.trends[:12],
@@ -276,13 +316,14 @@ class Discovery:
 
 
 def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[Extension, ...], responses,
-                  scales) -> Fit:
+                  scales, starts: list[SoilParameters] | None = None) -> Fit:
     """The current model plus ``exts`` fitted from the current fit, and from the current fit with the cohesion
-    of ``start`` and the new parameters mid-range: a fit can park a parameter where a mechanism has no gradient
-    (cohesion 0 for a gravity-scaled cohesion)."""
+    of ``start`` and the new parameters mid-range (a fit can park a parameter where a mechanism has no gradient:
+    cohesion 0 for a gravity-scaled cohesion), or from ``starts`` when given; the lowest error wins."""
     params = tuple(p for e in exts for p in e.parameters)
-    mid = {p.name: p.from_fit(0.5 * sum(p.fit_bounds)) for p in params}
-    starts = [current.soil, replace(current.soil, cohesion=max(current.soil.cohesion, start.cohesion), **mid)]
+    if starts is None:
+        mid = {p.name: p.from_fit(0.5 * sum(p.fit_bounds)) for p in params}
+        starts = [current.soil, replace(current.soil, cohesion=max(current.soil.cohesion, start.cohesion), **mid)]
     fits = []
     for s in starts:
         try:
@@ -290,6 +331,10 @@ def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[
         except WheelsoilInputError:  # a mid-range start outside the model's domain (a1 + a2 > 1)
             continue
     return min(fits, key=lambda f: f.sse)
+
+
+def _mid(ext: Extension) -> dict:
+    return {p.name: p.from_fit(0.5 * sum(p.fit_bounds)) for p in ext.parameters}
 
 
 def _heldout(soil, test, responses, scales) -> np.ndarray:
@@ -328,29 +373,51 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
     current, current_names, free = baseline, (), BASELINE_FREE
     lack_cur = lack_base
     steps: list[Step] = []
+
+    def trial(exts, fit, cur_err, cur_rmse, needs=None) -> Candidate:
+        err = _heldout(fit.soil, test, responses, scales)
+        rmse = float(np.sqrt(np.mean(err ** 2)))
+        idx = rng.integers(0, err.size, size=(bootstrap, err.size))  # paired bootstrap of the RMSE difference
+        diffs = np.sqrt(np.mean(cur_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
+        lack_new, _ = _lack_of_fit(fit.soil, train, responses, scales)
+        before = lack_cur["systematic"]
+        explained = 1.0 - lack_new["systematic"] / before if before > 0 else 0.0
+        return Candidate(exts[0], len(steps), fit, rmse, cur_rmse - rmse, float(np.std(diffs)),
+                         fit.bic - current.bic, mechanism_effect(fit.soil, exts, data, responses, scales),
+                         float(explained), _parameter_problems(exts, fit),
+                         effect_by_response=mechanism_effect(fit.soil, exts, data, responses, scales,
+                                                             by_response=True),
+                         partner=exts[1] if len(exts) > 1 else None, needs=needs or {})
+
     while remaining and len(current_names) < max_steps:
         cur_err = _heldout(current.soil, test, responses, scales)
         cur_rmse = float(np.sqrt(np.mean(cur_err ** 2)))
-        tried = []
+        singles = []
         for name in remaining:
             ext = EXTENSIONS[name]
-            fit = _fit_extended(train, current, free, base_start, (ext,), responses, scales)
-            err = _heldout(fit.soil, test, responses, scales)
-            rmse = float(np.sqrt(np.mean(err ** 2)))
-            idx = rng.integers(0, err.size, size=(bootstrap, err.size))  # paired bootstrap of the RMSE difference
-            diffs = np.sqrt(np.mean(cur_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
-            lack_new, _ = _lack_of_fit(fit.soil, train, responses, scales)
-            before = lack_cur["systematic"]
-            explained = 1.0 - lack_new["systematic"] / before if before > 0 else 0.0
-            tried.append(Candidate(ext, len(steps), fit, rmse, cur_rmse - rmse, float(np.std(diffs)),
-                                   fit.bic - current.bic, mechanism_effect(fit.soil, ext, data, responses, scales),
-                                   float(explained), _parameter_problems(ext, fit),
-                                   effect_by_response=mechanism_effect(fit.soil, ext, data, responses, scales,
-                                                                       by_response=True)))
-        tried.sort(key=lambda c: c.fit.bic)
+            singles.append(trial((ext,), _fit_extended(train, current, free, base_start, (ext,), responses, scales),
+                                 cur_err, cur_rmse))
+        singles.sort(key=lambda c: c.fit.bic)
+        tried = singles
         step = Step(len(steps), current_names, cur_rmse, lack_cur["systematic"], tried)
         steps.append(step)
         passing = [c for c in tried if c.passes]
+        if (not passing and len(current_names) + 2 <= max_steps and len(singles) >= 2
+                and unexplained_trends(lack_cur, [])):
+            # look-ahead: two mechanisms that act together can each fail alone
+            by_name = {c.extension.name: c for c in singles}
+            pool = [c.extension for c in singles[:PAIR_POOL]]
+            pairs = []
+            for a, b in combinations(pool, 2):
+                fa, fb = by_name[a.name].fit, by_name[b.name].fit
+                joint = _fit_extended(train, current, free, base_start, (a, b), responses, scales,
+                                      starts=[replace(fa.soil, **_mid(b)), replace(fb.soil, **_mid(a))])
+                pairs.append(trial((a, b), joint, cur_err, cur_rmse,
+                                   needs={b.name: joint.bic - fa.bic, a.name: joint.bic - fb.bic}))
+            pairs.sort(key=lambda c: c.fit.bic)
+            step = Step(len(steps), current_names, cur_rmse, lack_cur["systematic"], pairs, pairs=True)
+            steps.append(step)
+            tried, passing = pairs, [c for c in pairs if c.passes]
         if not passing:
             break
         best = passing[0]
@@ -358,18 +425,22 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
         for rival in passing[1:]:
             if rival.fit.bic - best.fit.bic >= AMBIGUITY_MARGIN:
                 continue
+            if rival.partner is not None:  # two pairs about equally good
+                unresolved.append(rival.name)
+                continue
             joint = _fit_extended(train, best.fit, free + best.extension.parameters, base_start,
                                   (rival.extension,), responses, scales)
-            if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems(rival.extension, joint):
-                unresolved.append(rival.extension.name)
+            if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems((rival.extension,), joint):
+                unresolved.append(rival.name)
         if unresolved:
-            step.ambiguity = [best.extension.name] + unresolved
+            step.ambiguity = [best.name] + unresolved
             break
         best.accepted = True
-        step.accepted = best.extension.name
-        current, current_names = best.fit, current_names + (best.extension.name,)
-        free = free + best.extension.parameters
-        remaining.remove(best.extension.name)
+        step.accepted = best.name
+        current, current_names = best.fit, current_names + tuple(best.names)
+        free = free + tuple(p for e in best.extensions for p in e.parameters)
+        for n in best.names:
+            remaining.remove(n)
         lack_cur, _ = _lack_of_fit(current.soil, train, responses, scales)
     final_err = _heldout(current.soil, test, responses, scales)
     _, final_trends = _lack_of_fit(current.soil, train, responses, scales)

@@ -199,7 +199,9 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
     Two checks keep a law from being named where the data cannot support it: the slip law must have seed 002's
     sign (eq. 25: the frequency falls with slip, b < 0), and where the wheel speed is tied to the slip
     (:func:`speed_slip_confound`) a law is named only if no other law fits within the tolerance too; otherwise
-    ``ambiguous`` lists the laws that fit and ``confound`` says why.
+    ``ambiguous`` lists the laws that fit and ``confound`` says why. Significant components that no law explains
+    (and no ambiguity covers) are described in ``unexplained``: their count per wheel turn, or their frequency
+    range, beside the wheel's declared grousers and spokes.
     """
     sig = [r for r in runs if r.component.significant]
     out = {"found": None, "laws": {}, "significant_runs": len(sig)}
@@ -267,7 +269,21 @@ def explain_frequencies(runs: list[Run], *, grousers: int = 0, spokes: int = 0) 
                            "counting law cannot be told apart; vary the wheel speed")
         else:
             out["found"] = best
+    if out["found"] is None and "ambiguous" not in out:
+        out["unexplained"] = _unexplained_oscillation(f, omega, grousers, spokes)
     return out
+
+
+def _unexplained_oscillation(f: np.ndarray, omega: np.ndarray, grousers: int, spokes: int) -> str:
+    """What the significant components ``f`` [Hz] that no law explains look like, in words: the count per wheel
+    turn when it is steady across runs (within :data:`LAW_TOLERANCE`), else their frequency range."""
+    counts = 2 * np.pi * f / omega
+    declared = f"the declared wheel has {grousers} grousers and {spokes} spokes"
+    if np.std(counts) <= LAW_TOLERANCE * np.mean(counts):
+        return (f"significant oscillations in {f.size} runs at {np.mean(counts):.3g} ± {np.std(counts):.2f} per "
+                f"wheel turn, which no law explains ({declared})")
+    return (f"significant oscillations in {f.size} runs at {f.min():.3g}-{f.max():.3g} Hz ({counts.min():.3g}-"
+            f"{counts.max():.3g} per wheel turn), which no law explains ({declared})")
 
 
 # -------------------------------------------------------------------- simulated time series
@@ -390,6 +406,8 @@ def periodic_report(results, quantity: str = "torque", *, source: str = "the run
                 short = "; at least 3 are needed" if found["significant_runs"] < 3 else ""
                 lines += ["", f"No law explains them within {LAW_TOLERANCE:.0%} and beats the simpler laws by "
                           f"{BIC_MARGIN:g} in BIC ({found['significant_runs']} significant runs{short})."]
+            if "unexplained" in found:
+                lines += ["", f"Unexplained: {found['unexplained']}."]
         out["report"] = str(write_markdown_and_json(report / "periodic.md", "\n".join(lines) + "\n",
                                                     report / "periodic.json", out))
     return out

@@ -11,7 +11,7 @@ import numpy as np
 
 from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
-from .discovery import BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, Discovery, model_responses
+from .discovery import BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, PAIR_POOL, Discovery, model_responses
 from .measured import Measurements
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
@@ -186,11 +186,15 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
     lof = findings["lack_of_fit"]
     lines += [f"| {q} | {lof['baseline'][q]['p_value']:.2g} | {lof['final'][q]['p_value']:.2g} |" for q in d.responses]
     lines += ["", "![](residuals.png)", "", "## Forward selection", "",
-              f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out gain exceeds "
-              f"{GAIN_SIGMAS:g} bootstrap standard deviations, its parameter is inside its physical range and of the "
-              f"mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of the systematic residual.", ""]
+              f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out gain is "
+              f"positive and exceeds {GAIN_SIGMAS:g} bootstrap standard deviation(s), its parameter is inside its "
+              f"physical range and of the mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of "
+              "the systematic residual. When no single mechanism passes and a systematic residual remains, the "
+              f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
+              f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone.", ""]
     for s in findings["steps"]:
-        lines += [f"### Step {s['step'] + 1}: on {' + '.join(['classical'] + s['model'])}", "",
+        kind = " (pairs, look-ahead)" if s.get("pairs") else ""
+        lines += [f"### Step {s['step'] + 1}{kind}: on {' + '.join(['classical'] + s['model'])}", "",
                   "| mechanism | parameters | held-out gain | ΔBIC | removes | verdict |", "|---|---|---|---|---|---|"]
         for c in s["candidates"]:
             params = ", ".join(f"{k} = {v['value']:.3g}" for k, v in c["parameters"].items())

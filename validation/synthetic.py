@@ -35,7 +35,10 @@ HIDDEN_RANGES = {
     "gravity_cohesion": {"cohesion_gravity_exponent": (1.0, 2.0)},
     "bulldozing": {"bulldozing_scale": (0.15, 0.4)},
     "multipass": {"multipass_k2": (0.1, 0.3)},
-    "gravity_pressure": {"kphi_gravity_exponent": (0.5, 1.0)},
+    # with k'_c free the modulus is c k'_c + rho g b k'_phi (g/g0)^-eps, i.e. A + B g^(1-eps): at eps = 1 (seed
+    # 000's constant K_phi) it is the classical model with k'_phi -> 0 exactly, and only the curvature in g tells
+    # eps apart from Reece's linear form (largest, about 5 % of the modulus over 1.62-9.81 m/s^2, at eps 0.3-0.7)
+    "gravity_pressure": {"kphi_gravity_exponent": (0.3, 0.7)},
     "gravity_soil_flow": {"soil_flow_gravity": (0.3, 0.6)},
 }
 

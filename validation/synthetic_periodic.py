@@ -65,6 +65,8 @@ def synthetic_periodic_report(hidden: str | None = None, *, seed: int = 0, repor
                                               + (f": {law['note']}." if "note" in law else ".")]
     if "confound" in law:
         lines += ["", f"Confound: {law['confound']}."]
+    if "unexplained" in law:
+        lines += ["", f"Unexplained: {law['unexplained']}."]
     amp = found["amplitude"]
     lines += ["", "## Amplitude mechanism", ""]
     if amp is None:

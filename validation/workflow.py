@@ -188,7 +188,9 @@ def main_validate(args) -> int:
         return 0
     if getattr(args, "cv", None):
         def show(fold):
-            console.print(f"  held out {args.cv} = {fold['level']}: found {', '.join(fold['found']) or 'nothing'}; "
+            partial = f" (partial: {', '.join(fold['partial'])})" if fold["partial"] else ""
+            console.print(f"  held out {args.cv} = {fold['level']}: found {', '.join(fold['found']) or 'nothing'}"
+                          f"{partial}; "
                           f"classical {fold['classical_nrmse']:.3f} -> {fold['final_nrmse']:.3f} "
                           f"(gain {fold['gain']:+.3f} +- {fold['gain_std']:.3f})", markup=False)
 
