@@ -7,8 +7,9 @@ update, hub update, hub nodes carried along, and (for static relaxation only) ki
   On a CPU a parallel loop costs tens of microseconds to dispatch, more than a small mesh's whole step, so
   small structures (the verification problems, the miniature wheel) run this way.
 * Parallel form (:func:`steps_parallel`): a kernel per number of steps n, compiled on first use, whose body
-  holds the n steps one after the other (unrolled at compile time), each a sequence of parallel loops --
-  one launch for the whole interval a coupling asks for, with every core on the elements and nodes.
+  holds the n steps one after the other (unrolled at compile time), each three tasks (the elements and the
+  nodes in parallel, the hub serially) -- one launch for the whole interval a coupling asks for, with every
+  core on the elements and nodes.
 All are launched as compute graphs (:class:`wheelsoil.graph_launch.GraphKernel`): their 30-odd array
 arguments are set in C++, not in Taichi's Python launch path (~9 us each). The results are the same to
 round-off in every form (the serial and parallel loops sum every node's slots in the same order).
@@ -158,20 +159,25 @@ def steps_parallel(n_steps: int) -> GraphKernel:
     ):
         gravity = vec3(gx, gy, gz)
         for _step in ti.static(range(n_steps)):
-            for e in range(n_facets):
-                shell_element(e, x, rot, tri, frame0, local0, km, kb, slot_f, slot_m, 0, 1)
-            for e in range(n_beams):
-                beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets, 1)
+            # three tasks a step: the elements (facets, then beams, in one parallel loop), the nodes, and one
+            # serial task for the hub, its nodes and kinetic damping. Every task costs a dispatch and, after a
+            # serial one, waking the other workers; the hub's 10-100 nodes take a microsecond or two on one thread.
+            for e in range(n_facets + n_beams):
+                if e < n_facets:
+                    shell_element(e, x, rot, tri, frame0, local0, km, kb, slot_f, slot_m, 0, 1)
+                else:
+                    beam_element(e - n_facets, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets,
+                                 1)
             for n in range(n_nodes):
                 itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
                                 m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
+            ti.loop_config(serialize=True)
             for _ in range(1):
                 if n_hub > 0:
                     itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot,
                                    m_tot)
-            for k in range(n_hub):
-                itg.hub_carry(k, hub_nodes, hub_offset, hub, hub_rot, x, v, rot, w)
-            for _ in range(1):
+                    for k in range(n_hub):
+                        itg.hub_carry(k, hub_nodes, hub_offset, hub, hub_rot, x, v, rot, w)
                 if kinetic:
                     _kinetic_restart(n_nodes, v, w, mass, inertia, free, peak)
 
