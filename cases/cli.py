@@ -363,7 +363,10 @@ def cmd_predict(args) -> int:
     writable_folder(args.out, "--out")
     out = predict_command(args.model, args.data, out=args.out, group=args.group)
     console = _console()
-    console.print(f"model: classical + {' + '.join(out['mechanisms']) or 'nothing'}; {out['rows']} rows")
+    partial = [m for m in out["mechanisms"] if m not in out["named"]]
+    console.print(f"model: classical + {' + '.join(out['mechanisms']) or 'nothing'}"
+                  f"{' (partial, not named as causes: ' + ', '.join(partial) + ')' if partial else ''}; "
+                  f"{out['rows']} rows")
     for q, e in out["errors"].items():
         console.print(f"  {q:14s} RMSE classical {e['baseline']['rmse']:.4g}, model {e['final']['rmse']:.4g} "
                       f"(normalised {e['baseline']['nrmse']:.3f} -> {e['final']['nrmse']:.3f}; {e['rows']} rows)")

@@ -28,8 +28,9 @@ FORMAT = "wheelsoil-terramechanics-model/1"
 
 @dataclass
 class SavedModel:
-    """A calibrated model: the final soil (classical + ``mechanisms``), the classical one, the responses it was
-    fitted to and their normalisation scales [response units]."""
+    """A calibrated model: the final soil (classical + ``mechanisms``: every accepted mechanism, named as a cause or
+    partial; ``meta["named"]`` lists the named ones), the classical one, the responses it was fitted to and their
+    normalisation scales [response units]."""
 
     soil: SoilParameters
     baseline: SoilParameters
@@ -76,7 +77,9 @@ def save_model(path: str | Path, discovery, train: Measurements, *, command: str
     """Write the discovery's final model, its classical model and the training rows to ``path`` (JSON)."""
     doc = {
         "format": FORMAT,
-        "mechanisms": discovery.found,
+        # every mechanism in the final model's soil: those named as causes and those accepted as partial
+        "mechanisms": [n for c in discovery.accepted for n in c.names],
+        "named": discovery.found,
         "soil": asdict(discovery.final.soil),
         "baseline_soil": asdict(discovery.baseline.soil),
         "responses": list(discovery.responses),
@@ -119,7 +122,8 @@ def load_model(path: str | Path) -> SavedModel:
                                   f"expected {FORMAT!r})")
     return SavedModel(_soil(doc["soil"], path), _soil(doc["baseline_soil"], path), list(doc["mechanisms"]),
                       list(doc["responses"]), {q: float(v) for q, v in doc["scales"].items()}, doc["training_data"],
-                      {k: doc.get(k) for k in ("command", "provenance", "parameters", "ambiguities", "unexplained")})
+                      {k: doc.get(k) for k in ("command", "provenance", "parameters", "named", "ambiguities",
+                                                "unexplained")})
 
 
 def write_predictions(model: SavedModel, data: Measurements, out: str | Path) -> tuple[Path, dict]:
