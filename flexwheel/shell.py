@@ -17,13 +17,19 @@ Felippa & Haugen (2005), CMAME 194, 2285-2335:
    omega_z = (v_1 - v_0) / l_01 (rotation of side 0->1).
 6. forces go to the global frame with T and are written per element corner into a slot array that
    the node update gathers (no float atomics).
+
+The two 9x9 blocks are stored packed (:func:`pack_stiffness`): both are symmetric (K = int B^T D B), and the
+bending block only ever multiplies the facet's bending deformation, whose normal translations (entries 0, 3 and
+6) vanish because the nodes lie in the facet's own plane (step 2). Membrane: the 45 entries of the upper
+triangle; bending: the 21 of the upper triangle over the six rotation entries and the 18 that turn them into
+normal forces -- 84 numbers a facet instead of 162, which the element loop reads every sub-step.
 """
 
 
 import numpy as np
 import taichi as ti
 
-from wheelsoil.taichi_types import mat3, nd_f64, nd_ivec3, nd_mat3, nd_mat9, nd_mat32, nd_vec3, vec3, vec9
+from wheelsoil.taichi_types import mat3, nd_f64, nd_f64_2d, nd_ivec3, nd_mat3, nd_mat32, nd_vec3, vec3, vec9
 
 from .rotation import log_so3, spin_jacobian_inverse
 from .shell_stiffness import bending_stiffness, membrane_stiffness
@@ -43,6 +49,31 @@ def facet_frames(x: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return frames, local
 
 
+def _upper(n: int) -> list[tuple[int, int]]:
+    return [(i, j) for i in range(n) for j in range(i, n)]
+
+
+#: (row, column) of each packed membrane entry: the upper triangle of the 9x9 block
+MEMBRANE_PACK = _upper(9)
+#: the bending deformation's non-zero entries (rotations about the facet's two in-plane axes at each corner)
+BENDING_ROTATIONS = (1, 2, 4, 5, 7, 8)
+#: (row, column) of each packed bending entry: the upper triangle over the rotations, then the normal-force rows
+BENDING_PACK = ([(BENDING_ROTATIONS[i], BENDING_ROTATIONS[j]) for i, j in _upper(6)]
+                + [(r, c) for r in (0, 3, 6) for c in BENDING_ROTATIONS])
+
+
+def pack_stiffness(km: np.ndarray, kb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 9, 9) membrane and bending blocks -> (n, 45) and (n, 39) (see the module docstring). Checks the
+    symmetry the packing relies on."""
+    for name, k in (("membrane", km), ("bending", kb)):
+        scale = max(float(np.abs(k).max()), 1e-300)
+        if not np.allclose(k, np.swapaxes(k, 1, 2), rtol=0.0, atol=1e-10 * scale):
+            raise ValueError(f"{name} stiffness blocks are not symmetric")
+    rm, cm = np.array(MEMBRANE_PACK).T
+    rb, cb = np.array(BENDING_PACK).T
+    return np.ascontiguousarray(km[:, rm, cm]), np.ascontiguousarray(kb[:, rb, cb])
+
+
 def shell_setup(nodes, triangles, thickness, material, drilling_penalty):
     """Reference frames, local coordinates and the two 9x9 stiffness blocks of every facet."""
     frames, local = facet_frames(nodes, triangles)
@@ -50,6 +81,38 @@ def shell_setup(nodes, triangles, thickness, material, drilling_penalty):
     km = membrane_stiffness(local, thickness, e, nu, drilling_penalty)
     kb = bending_stiffness(local, thickness, e, nu)
     return frames, local, km, kb
+
+
+@ti.func
+def _membrane_times(k: ti.template(), e: ti.i32, d: vec9) -> vec9:
+    """K_m d of facet e from its packed upper triangle ``k[e, :]`` (45 entries, :data:`MEMBRANE_PACK`)."""
+    f = vec9(0.0)
+    for i in ti.static(range(9)):
+        for j in ti.static(range(i, 9)):
+            p = ti.static(MEMBRANE_PACK.index((i, j)))
+            f[i] += k[e, p] * d[j]
+            if ti.static(i != j):
+                f[j] += k[e, p] * d[i]
+    return f
+
+
+@ti.func
+def _bending_times(k: ti.template(), e: ti.i32, d: vec9) -> vec9:
+    """K_b d of facet e from its packed bending entries ``k[e, :]`` (39, :data:`BENDING_PACK`), for d with
+    d[0] = d[3] = d[6] = 0."""
+    f = vec9(0.0)
+    for a in ti.static(range(6)):
+        for b in ti.static(range(a, 6)):
+            i, j = ti.static(BENDING_ROTATIONS[a], BENDING_ROTATIONS[b])
+            p = ti.static(BENDING_PACK.index((i, j)))
+            f[i] += k[e, p] * d[j]
+            if ti.static(i != j):
+                f[j] += k[e, p] * d[i]
+    for r in ti.static((0, 3, 6)):
+        for c in ti.static(BENDING_ROTATIONS):
+            p = ti.static(BENDING_PACK.index((r, c)))
+            f[r] += k[e, p] * d[c]
+    return f
 
 
 @ti.func
@@ -84,8 +147,8 @@ def shell_element(
         dm[3 * a + 2] = th[a][2]
         db[3 * a + 1] = th[a][0]
         db[3 * a + 2] = th[a][1]
-    fm = km[e] @ dm
-    fb = kb[e] @ db
+    fm = _membrane_times(km, e, dm)
+    fb = _bending_times(kb, e, db)
     energy = 0.5 * (dm.dot(fm) + db.dot(fb))
     if write:
         f = [vec3(0.0), vec3(0.0), vec3(0.0)]
@@ -110,8 +173,8 @@ def shell_element(
 
 @ti.kernel
 def shell_forces(
-    x: nd_vec3, rot: nd_mat3, tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9,
-    kb: nd_mat9, slot_f: nd_vec3, slot_m: nd_vec3, slot_base: ti.i32,
+    x: nd_vec3, rot: nd_mat3, tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d,
+    kb: nd_f64_2d, slot_f: nd_vec3, slot_m: nd_vec3, slot_base: ti.i32,
 ):
     """Internal nodal forces and moments of every facet (one slot per facet corner)."""
     for e in tri:
@@ -120,8 +183,8 @@ def shell_forces(
 
 @ti.kernel
 def shell_energies(
-    x: nd_vec3, rot: nd_mat3, tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9,
-    kb: nd_mat9, slot_f: nd_vec3, slot_m: nd_vec3, energy: nd_f64,
+    x: nd_vec3, rot: nd_mat3, tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d,
+    kb: nd_f64_2d, slot_f: nd_vec3, slot_m: nd_vec3, energy: nd_f64,
 ):
     """Strain energy of every facet [J]."""
     for e in tri:

@@ -21,7 +21,7 @@ from functools import cached_property
 import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
-from wheelsoil.taichi_types import nd_f64, nd_i32, nd_ivec2, nd_ivec3, nd_mat3, nd_mat9, nd_mat32, nd_vec3, nd_vec4, vec3
+from wheelsoil.taichi_types import nd_f64, nd_f64_2d, nd_i32, nd_ivec2, nd_ivec3, nd_mat3, nd_mat32, nd_vec3, nd_vec4, vec3
 
 from . import integrator as itg
 from .beam import beam_element
@@ -37,7 +37,7 @@ class StructureArrays:
     k_ext, x_anchor (the contact's lumped normal stiffness [N/m] and the position it was taken at); f_tot, m_tot
     (the last step's resultant per node). Element corners: slot_start, slot_list (each node's corner slots),
     slot_f, slot_m (the corners' forces and moments). Facets: tri, frame0, local0, km, kb (corners, reference
-    frame and local coordinates, membrane and bending stiffness). Beams: ends, bframe0, blen0, rigidity. Hub:
+    frame and local coordinates, membrane and bending stiffness, packed: :func:`.shell.pack_stiffness`). Beams: ends, bframe0, blen0, rigidity. Hub:
     hub_nodes, hub_offset, hub (its rows, :data:`.integrator.HUB_ROWS`), hub_rot, hub_scalar. peak: kinetic
     damping's last energy.
     """
@@ -108,7 +108,7 @@ def _steps_serial(
     x: nd_vec3, v: nd_vec3, rot: nd_mat3, w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
     f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32,
     slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3,
-    tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9, kb: nd_mat9,
+    tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d, kb: nd_f64_2d,
     ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
     hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
 ):
@@ -153,7 +153,7 @@ def steps_parallel(n_steps: int) -> GraphKernel:
         x: nd_vec3, v: nd_vec3, rot: nd_mat3, w: nd_vec3, mass: nd_f64, inertia: nd_f64, free: nd_i32,
         f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, m_ext: nd_vec3, slot_start: nd_i32, slot_list: nd_i32,
         slot_f: nd_vec3, slot_m: nd_vec3, f_tot: nd_vec3, m_tot: nd_vec3,
-        tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_mat9, kb: nd_mat9,
+        tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d, kb: nd_f64_2d,
         ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
         hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
     ):

@@ -17,14 +17,14 @@ import taichi as ti
 
 from wheelsoil import runtime
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
-from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat9, mat32, vec3, vec4
+from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat32, vec3, vec4
 from wheelsoil.taichi_types import to_ndarray as _nd
 
 from . import integrator as itg
 from . import stepper
 from .beam import beam_energies, beam_forces, beam_frames, beam_section_stiffness
 from .mesh import StructureMesh
-from .shell import shell_energies, shell_forces, shell_setup
+from .shell import BENDING_PACK, MEMBRANE_PACK, pack_stiffness, shell_energies, shell_forces, shell_setup
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
@@ -180,14 +180,15 @@ class Structure:
             d["tri"] = _nd(ivec3, mesh.triangles.astype(np.int32))
             d["frame0"] = _nd(mat3, frames)
             d["local0"] = _nd(mat32, local)
-            d["km"] = _nd(mat9, km)
-            d["kb"] = _nd(mat9, kb)
+            km_packed, kb_packed = pack_stiffness(km, kb)
+            d["km"] = _nd(ti.f64, km_packed)
+            d["kb"] = _nd(ti.f64, kb_packed)
         else:
             d["tri"] = _nd(ivec3, np.zeros((1, 3), np.int32))
             d["frame0"] = _nd(mat3, np.eye(3)[None])
             d["local0"] = _nd(mat32, np.zeros((1, 3, 2)))
-            d["km"] = _nd(mat9, np.zeros((1, 9, 9)))
-            d["kb"] = _nd(mat9, np.zeros((1, 9, 9)))
+            d["km"] = _nd(ti.f64, np.zeros((1, len(MEMBRANE_PACK))))
+            d["kb"] = _nd(ti.f64, np.zeros((1, len(BENDING_PACK))))
         if self.n_beams:
             bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
             d["ends"] = _nd(ivec2, mesh.beams.astype(np.int32))

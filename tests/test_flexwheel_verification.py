@@ -219,6 +219,50 @@ def test_internal_forces_are_the_gradient_of_the_strain_energy_and_match_the_ass
         assert np.allclose(tangent, k_lin[:, 6 * node + k], atol=1e-6 * np.abs(k_lin).max())
 
 
+def test_packed_stiffness_blocks_multiply_like_the_full_ones():
+    """The element loop reads each facet's stiffness packed (symmetric membrane block: upper triangle; bending
+    block: only what multiplies the in-plane rotations). Its products equal the full 9x9 products of
+    shell_setup for every facet of a bent strip, and a block that is not symmetric is refused."""
+    import taichi as ti
+
+    from wheelsoil.flexwheel.shell import _bending_times, _membrane_times, pack_stiffness, shell_setup
+    from wheelsoil.taichi_types import nd_f64_2d, to_ndarray, vec9
+
+    s, _, _ = _bent_strip_state()
+    mesh = s.mesh
+    _, _, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
+    km_p, kb_p = pack_stiffness(km, kb)
+    rng = np.random.default_rng(0)
+    dm = rng.normal(size=(len(km), 9))
+    db = rng.normal(size=(len(kb), 9))
+    db[:, [0, 3, 6]] = 0.0  # a flat facet's nodes have no normal deformational translation
+
+    @ti.kernel
+    def products(km: nd_f64_2d, kb: nd_f64_2d, dm: nd_f64_2d, db: nd_f64_2d, fm: nd_f64_2d, fb: nd_f64_2d):
+        for e in range(km.shape[0]):
+            a = vec9(0.0)
+            b = vec9(0.0)
+            for i in ti.static(range(9)):
+                a[i] = dm[e, i]
+                b[i] = db[e, i]
+            fa = _membrane_times(km, e, a)
+            fbe = _bending_times(kb, e, b)
+            for i in ti.static(range(9)):
+                fm[e, i] = fa[i]
+                fb[e, i] = fbe[i]
+
+    fm, fb = to_ndarray(ti.f64, np.zeros_like(dm)), to_ndarray(ti.f64, np.zeros_like(db))
+    products(to_ndarray(ti.f64, km_p), to_ndarray(ti.f64, kb_p), to_ndarray(ti.f64, dm), to_ndarray(ti.f64, db),
+             fm, fb)
+    scale_m, scale_b = np.abs(km).max(), np.abs(kb).max()
+    assert np.allclose(fm.to_numpy(), np.einsum("eij,ej->ei", km, dm), rtol=0, atol=1e-12 * scale_m)
+    assert np.allclose(fb.to_numpy(), np.einsum("eij,ej->ei", kb, db), rtol=0, atol=1e-12 * scale_b)
+    lopsided = km.copy()
+    lopsided[0, 0, 1] += 1e-3 * scale_m
+    with pytest.raises(ValueError, match="membrane stiffness blocks are not symmetric"):
+        pack_stiffness(lopsided, kb)
+
+
 def test_undamped_free_vibration_conserves_energy_and_momentum():
     """A free strip set spinning and vibrating: total energy constant within 0.5 % over several
     vibration periods (central difference: bounded, O(dt^2) fluctuation); linear momentum exact."""

@@ -15,6 +15,7 @@ mat32 = ti.types.matrix(3, 2, ti.f64)
 mat23 = ti.types.matrix(2, 3, ti.f64)
 
 nd_f64 = ti.types.ndarray(dtype=ti.f64, ndim=1)
+nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 nd_i32 = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd_i32_2d = ti.types.ndarray(dtype=ti.i32, ndim=2)
 nd_vec3 = ti.types.ndarray(dtype=vec3, ndim=1)
@@ -24,6 +25,7 @@ nd_ivec2 = ti.types.ndarray(dtype=ivec2, ndim=1)
 nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
 nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
 nd_mat9 = ti.types.ndarray(dtype=mat9, ndim=1)
+
 nd_mat32 = ti.types.ndarray(dtype=mat32, ndim=1)
 nd_mat23 = ti.types.ndarray(dtype=mat23, ndim=1)
 
