@@ -24,11 +24,9 @@ from wheelsoil.graph_launch import GraphKernel
 from wheelsoil.granular.contact import hertz_mindlin
 from wheelsoil.granular.grid import cell_coords, cell_index
 from wheelsoil.granular.neighbors import sort_run
-from wheelsoil.taichi_types import ivec3, nd_f64, nd_f64_2d, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
+from wheelsoil.taichi_types import ivec3, nd_f64, nd_f64_2d, nd_i32, nd_i32_2d, nd_ivec3, nd_vec3, nd_vec3_2d, vec3
 
 from .closest_point import EDGE_AB, EDGE_CA, FACE, VERTEX_A, closest_point_on_triangle
-
-nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
 
 #: Rows of the resultant array: force and moment of this step, their running sums, sample count.
 RES_FORCE, RES_MOMENT, RES_FORCE_SUM, RES_MOMENT_SUM, RES_SAMPLES = range(5)

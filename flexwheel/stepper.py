@@ -37,9 +37,9 @@ class StructureArrays:
     k_ext, x_anchor (the contact's lumped normal stiffness [N/m] and the position it was taken at); f_tot, m_tot
     (the last step's resultant per node). Element corners: slot_start, slot_list (each node's corner slots),
     slot_f, slot_m (the corners' forces and moments). Facets: tri, frame0, local0, km, kb (corners, reference
-    frame and local coordinates, membrane and bending stiffness, packed: :func:`.shell.pack_stiffness`). Beams: ends, bframe0, blen0, rigidity. Hub:
-    hub_nodes, hub_offset, hub (its rows, :data:`.integrator.HUB_ROWS`), hub_rot, hub_scalar. peak: kinetic
-    damping's last energy.
+    frame and local coordinates, membrane and bending stiffness, packed: :func:`.shell.pack_stiffness`). Beams:
+    ends, bframe0, blen0, rigidity. Hub: hub_nodes, hub_offset, hub (its rows, :data:`.integrator.HUB_ROWS`),
+    hub_rot, hub_scalar. peak: kinetic damping's last energy.
     """
 
     x: ti.Ndarray

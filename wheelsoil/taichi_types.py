@@ -10,7 +10,6 @@ vec9 = ti.types.vector(9, ti.f64)
 ivec2 = ti.types.vector(2, ti.i32)
 ivec3 = ti.types.vector(3, ti.i32)
 mat3 = ti.types.matrix(3, 3, ti.f64)
-mat9 = ti.types.matrix(9, 9, ti.f64)
 mat32 = ti.types.matrix(3, 2, ti.f64)
 mat23 = ti.types.matrix(2, 3, ti.f64)
 
@@ -24,8 +23,6 @@ nd_vec4 = ti.types.ndarray(dtype=vec4, ndim=1)
 nd_ivec2 = ti.types.ndarray(dtype=ivec2, ndim=1)
 nd_ivec3 = ti.types.ndarray(dtype=ivec3, ndim=1)
 nd_mat3 = ti.types.ndarray(dtype=mat3, ndim=1)
-nd_mat9 = ti.types.ndarray(dtype=mat9, ndim=1)
-
 nd_mat32 = ti.types.ndarray(dtype=mat32, ndim=1)
 nd_mat23 = ti.types.ndarray(dtype=mat23, ndim=1)
 
