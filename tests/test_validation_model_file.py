@@ -32,7 +32,7 @@ def test_saved_model_reproduces_its_predictions_exactly(small_discovery, tmp_pat
     path = save_model(tmp_path / "model.json", d, data.select(~mask))
     model = load_model(path)
     assert model.mechanisms == ["slip_sinkage"] and model.soil == d.final.soil and model.baseline == d.baseline.soil
-    assert model.meta["named"] == ["slip_sinkage"]
+    assert model.named == ["slip_sinkage"]
     fresh, saved = model_responses(d.final.soil, data), model.predict(data)
     for q in fresh:
         assert np.array_equal(fresh[q], saved[q], equal_nan=True), q  # bit for bit
@@ -55,7 +55,7 @@ def test_a_partial_mechanism_is_in_the_saved_model_but_not_named(small_discovery
     finally:
         accepted.partial = saved_partial
     model = load_model(path)
-    assert model.mechanisms == ["slip_sinkage"] and model.meta["named"] == []
+    assert model.mechanisms == ["slip_sinkage"] and model.named == []
     csv = save_measurements(data, tmp_path / "d.csv")
     assert main(["predict", str(path), str(csv), "--out", str(tmp_path / "p")]) == EXIT_OK
     assert "partial, not named as causes: slip_sinkage" in " ".join(capsys.readouterr().out.split())

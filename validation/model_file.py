@@ -29,7 +29,7 @@ FORMAT = "wheelsoil-terramechanics-model/1"
 @dataclass
 class SavedModel:
     """A calibrated model: the final soil (classical + ``mechanisms``: every accepted mechanism, named as a cause or
-    partial; ``meta["named"]`` lists the named ones), the classical one, the responses it was fitted to and their
+    partial; ``named``: those named as causes), the classical one, the responses it was fitted to and their
     normalisation scales [response units]."""
 
     soil: SoilParameters
@@ -39,6 +39,7 @@ class SavedModel:
     scales: dict[str, float]
     training: dict
     meta: dict
+    named: list[str]
 
     def predict(self, data: Measurements, *, which: str = "final") -> dict[str, np.ndarray]:
         """Responses of the final (or ``which="baseline"``: the classical) model at every row of ``data``."""
@@ -122,8 +123,9 @@ def load_model(path: str | Path) -> SavedModel:
                                   f"expected {FORMAT!r})")
     return SavedModel(_soil(doc["soil"], path), _soil(doc["baseline_soil"], path), list(doc["mechanisms"]),
                       list(doc["responses"]), {q: float(v) for q, v in doc["scales"].items()}, doc["training_data"],
-                      {k: doc.get(k) for k in ("command", "provenance", "parameters", "named", "ambiguities",
-                                                "unexplained")})
+                      {k: doc.get(k) for k in ("command", "provenance", "parameters", "ambiguities", "unexplained")},
+                      # a file without "named" listed only the named mechanisms
+                      list(doc.get("named", doc["mechanisms"])))
 
 
 def write_predictions(model: SavedModel, data: Measurements, out: str | Path) -> tuple[Path, dict]:

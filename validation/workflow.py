@@ -151,9 +151,8 @@ def predict_command(model_path: str, data_arg: str, *, out: Path, group: str | N
     model = load_model(model_path)
     data, _, _ = _load_prepared(data_arg, group)
     path, errors = write_predictions(model, data, out)
-    named = model.meta.get("named")
-    return {"predictions": str(path), "errors": errors, "mechanisms": model.mechanisms,
-            "named": model.mechanisms if named is None else named, "rows": len(data)}
+    return {"predictions": str(path), "errors": errors, "mechanisms": model.mechanisms, "named": model.named,
+            "rows": len(data)}
 
 
 def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, responses=None, group: str | None = None,
