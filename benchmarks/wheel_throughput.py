@@ -6,12 +6,20 @@ and a coarse copy, times steady stepping in the serial (one launch per batch of 
 particles of 16-24 mm, seed-004 Table 1 soil, steel wall pairs), i.e. how many wheel sub-steps one
 DEM step costs, and what that interval takes on this machine.
 
+Also the compile time of the smoke wheel's stepping kernel (two sub-steps a launch, as a coupled smoke run
+takes them) in a fresh process with an empty Taichi kernel cache, then with the cache it filled.
+
 Run:  python -m wheelsoil.benchmarks.wheel_throughput [--out benchmarks/results/wheel.json]
+      python -m wheelsoil.benchmarks.wheel_throughput --compile-only
 """
 
 import argparse
 import json
 import math
+import os
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -29,12 +37,54 @@ def _time_steps(structure, n_steps: int, repeats: int = 3) -> float:
     return best
 
 
+_COMPILE_CODE = """
+import time
+t0 = time.perf_counter()
+from wheelsoil import runtime
+runtime.init({arch!r})
+from wheelsoil.cases.build import wheel_geometry
+from wheelsoil.cases.schema import load_case
+from wheelsoil.flexwheel.geometry import build_wheel_mesh
+from wheelsoil.flexwheel.structure import Structure
+mesh, hub = build_wheel_mesh(wheel_geometry(load_case("smoke-1g-steer")))
+wheel = Structure(mesh, hub_nodes=hub, serial=False)
+t1 = time.perf_counter()
+wheel.step(2)
+t2 = time.perf_counter()
+wheel.step(2)
+print(t1 - t0, t2 - t1, time.perf_counter() - t2)
+"""
+
+
+def compile_time_cold_wheel(arch=None) -> dict:
+    """Seconds to set up the smoke wheel, to its first two sub-steps (the stepping kernel's compile) and to the
+    next two, in a fresh process with an empty Taichi kernel cache (``cold_cache``) and then with the cache it
+    filled (``warm_cache``)."""
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
+        for label in ("cold_cache", "warm_cache"):
+            res = subprocess.run([sys.executable, "-c", _COMPILE_CODE.format(arch=arch)], capture_output=True,
+                                 text=True, env=env)
+            if res.returncode != 0:
+                raise RuntimeError(res.stderr)
+            setup, first, second = (float(v) for v in res.stdout.split()[-3:])
+            out[label] = {"setup_s": setup, "first_two_substeps_s": first, "next_two_substeps_s": second}
+    return out
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("benchmarks/results/wheel.json"))
     parser.add_argument("--steps", type=int, default=200, help="steps per timing (default 200)")
     parser.add_argument("--arch", default=None, help="Taichi backend (default cpu)")
+    parser.add_argument("--compile-only", action="store_true",
+                        help="only the smoke wheel's stepping-kernel compile time, cold and warm cache")
     args = parser.parse_args(argv)
+    if args.compile_only:
+        compile_times = compile_time_cold_wheel(args.arch)
+        print("smoke wheel, first two sub-steps:", json.dumps(compile_times))
+        return 0
     runtime.init(args.arch)
 
     from wheelsoil.flexwheel.geometry import LUNAR_ROVER, build_wheel_mesh
@@ -75,6 +125,8 @@ def main(argv=None) -> int:
                   f"{wheel.stable_time_step:.3e} s vs soil dt {soil_dt:.3e} s -> {substeps} sub-steps, "
                   f"{1e3 * case['seconds_per_dem_step_interval']:.2f} ms per DEM step")
     results["peak_rss_mib"] = peak_rss_mib()
+    results["compile"] = compile_time_cold_wheel(args.arch)
+    print("smoke wheel, first two sub-steps:", json.dumps(results["compile"]))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(results, indent=2))
     print(f"peak RSS {results['peak_rss_mib']:.0f} MiB; wrote {args.out}")

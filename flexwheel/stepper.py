@@ -138,13 +138,16 @@ steps_serial = GraphKernel(_steps_serial)
 _PARALLEL: dict = {}
 
 
-def steps_parallel(n_steps: int) -> GraphKernel:
+def steps_parallel(n_steps: int, beams: bool = True) -> GraphKernel:
     """The parallel stepping kernel for exactly ``n_steps`` steps (compiled once per count), as a compute graph
     taking (dt, damping, gx, gy, gz, kinetic, n_nodes, n_facets, n_beams, n_hub, *StructureArrays.kernel_args).
+    Without ``beams`` the kernel holds no beam element (``n_beams`` must be 0): the beam's code is half the
+    compile time of a shell-only wheel's kernel.
     """
-    n_steps = int(n_steps)
-    if n_steps in _PARALLEL:
-        return _PARALLEL[n_steps]
+    key = (int(n_steps), bool(beams))
+    if key in _PARALLEL:
+        return _PARALLEL[key]
+    n_steps = key[0]
 
     @ti.kernel
     def _steps(
@@ -166,8 +169,9 @@ def steps_parallel(n_steps: int) -> GraphKernel:
                 if e < n_facets:
                     shell_element(e, x, rot, tri, frame0, local0, km, kb, slot_f, slot_m, 0, 1)
                 else:
-                    beam_element(e - n_facets, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets,
-                                 1)
+                    if ti.static(beams):
+                        beam_element(e - n_facets, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m,
+                                     3 * n_facets, 1)
             for n in range(n_nodes):
                 itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
                                 m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
@@ -181,5 +185,5 @@ def steps_parallel(n_steps: int) -> GraphKernel:
                 if kinetic:
                     _kinetic_restart(n_nodes, v, w, mass, inertia, free, peak)
 
-    _PARALLEL[n_steps] = GraphKernel(_steps)
-    return _PARALLEL[n_steps]
+    _PARALLEL[key] = GraphKernel(_steps)
+    return _PARALLEL[key]

@@ -306,8 +306,8 @@ class Structure:
         else:
             chunk = self.PARALLEL_STEPS_PER_LAUNCH
             for done in range(0, n_steps, chunk):
-                stepper.steps_parallel(min(chunk, n_steps - done))(dt, self.damping, *g, int(kinetic_damping),
-                                                                    *counts, *arrays)
+                stepper.steps_parallel(min(chunk, n_steps - done), beams=n_beams > 0)(
+                    dt, self.damping, *g, int(kinetic_damping), *counts, *arrays)
         self.time += dt * n_steps
         self.steps_taken += n_steps
 
