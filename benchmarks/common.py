@@ -107,6 +107,21 @@ def reference_workload_seconds(repeats: int = 5) -> float:
     return best
 
 
+def cache_times(code: str, names: tuple[str, ...]) -> dict:
+    """Run the Python ``code`` in a fresh process with an empty Taichi kernel cache (``cold_cache``), then again
+    with the cache it filled (``warm_cache``); the last ``len(names)`` numbers it prints are the times [s], keyed
+    by ``names``."""
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
+        for label in ("cold_cache", "warm_cache"):
+            res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+            if res.returncode != 0:
+                raise RuntimeError(res.stderr)
+            out[label] = dict(zip(names, (float(v) for v in res.stdout.split()[-len(names):])))
+    return out
+
+
 def compile_time_cold() -> dict:
     """Time to the end of the first step of a small scene in a fresh process, with an empty Taichi
     kernel cache (``cold_cache``) and then with the cache it filled (``warm_cache``) [s]."""
@@ -119,13 +134,4 @@ def compile_time_cold() -> dict:
         "s.step(1); t2=time.perf_counter(); s.step(1); t3=time.perf_counter();"
         "print(t1-t0, t2-t1, t3-t2)"
     )
-    out = {}
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
-        for label in ("cold_cache", "warm_cache"):
-            res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-            if res.returncode != 0:
-                raise RuntimeError(res.stderr)
-            t_init, t_first, t_second = (float(v) for v in res.stdout.split()[-3:])
-            out[label] = {"init_s": t_init, "first_step_s": t_first, "steady_step_s": t_second}
-    return out
+    return cache_times(code, ("init_s", "first_step_s", "steady_step_s"))

@@ -222,6 +222,7 @@ def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
     }
     simulated = smoke["lowering_and_settling_simulated_seconds"] + 0.05 + SEED004_DRIVE_TIME
     per_step = sum(ms.values())
+    soil_alone = smoke["ms_per_step_soil_alone"] * particles
     steps = simulated / dt
     return {
         "particles": SEED004_PARTICLES,
@@ -232,8 +233,8 @@ def extrapolate(smoke: dict, fe: dict, dem: dict, base: dict) -> dict:
         "scale_factors": {"particles": particles, "contacts": contacts},
         "ms_per_step": ms | {"total": per_step},
         # against the same bed alone: the soil-alone cost per particle-step measured at smoke scale, times the count
-        "ms_per_step_soil_alone": smoke["ms_per_step_soil_alone"] * particles,
-        "coupled_over_soil_alone": per_step / (smoke["ms_per_step_soil_alone"] * particles),
+        "ms_per_step_soil_alone": soil_alone,
+        "coupled_over_soil_alone": per_step / soil_alone,
         "wall_seconds_per_simulated_second": per_step * 1e-3 / dt,
         "protocol_simulated_seconds": simulated,
         "protocol_wall_hours": per_step * 1e-3 * steps / 3600.0,

@@ -16,15 +16,11 @@ Run:  python -m wheelsoil.benchmarks.wheel_throughput [--out benchmarks/results/
 import argparse
 import json
 import math
-import os
-import subprocess
-import sys
-import tempfile
 import time
 from pathlib import Path
 
 from wheelsoil import runtime
-from wheelsoil.benchmarks.common import machine, peak_rss_mib, versions
+from wheelsoil.benchmarks.common import cache_times, machine, peak_rss_mib, versions
 
 
 def _time_steps(structure, n_steps: int, repeats: int = 3) -> float:
@@ -60,17 +56,7 @@ def compile_time_cold_wheel(arch=None) -> dict:
     """Seconds to set up the smoke wheel, to its first two sub-steps (the stepping kernel's compile) and to the
     next two, in a fresh process with an empty Taichi kernel cache (``cold_cache``) and then with the cache it
     filled (``warm_cache``)."""
-    out = {}
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, WHEELSOIL_TAICHI_CACHE=cache)
-        for label in ("cold_cache", "warm_cache"):
-            res = subprocess.run([sys.executable, "-c", _COMPILE_CODE.format(arch=arch)], capture_output=True,
-                                 text=True, env=env)
-            if res.returncode != 0:
-                raise RuntimeError(res.stderr)
-            setup, first, second = (float(v) for v in res.stdout.split()[-3:])
-            out[label] = {"setup_s": setup, "first_two_substeps_s": first, "next_two_substeps_s": second}
-    return out
+    return cache_times(_COMPILE_CODE.format(arch=arch), ("setup_s", "first_two_substeps_s", "next_two_substeps_s"))
 
 
 def main(argv=None) -> int:
