@@ -52,7 +52,7 @@ from .calibration import (
     normalised_residuals,
     response_scales,
 )
-from .extensions import BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension
+from .extensions import BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, drift_rival, drift_rivals
 from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
 from .terramechanics import SoilParameters
@@ -234,11 +234,13 @@ class Step:
     ambiguity: list[str] = field(default_factory=list)
     #: a look-ahead step: its candidates are pairs of mechanisms fitted together
     pairs: bool = False
+    #: the generic drifts fitted in place of the best passing mechanism (:func:`_drift_rivals`), best first
+    rivals: list[dict] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"step": self.index, "model": list(self.model), "heldout_rmse": self.heldout_rmse,
                 "systematic_residual": self.systematic, "accepted": self.accepted, "ambiguity": self.ambiguity,
-                "pairs": self.pairs,
+                "pairs": self.pairs, "rivals": self.rivals,
                 "candidates": [c.to_dict() for c in self.candidates]}
 
 
@@ -331,6 +333,26 @@ def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[
         except WheelsoilInputError:  # a mid-range start outside the model's domain (a1 + a2 > 1)
             continue
     return min(fits, key=lambda f: f.sse)
+
+
+def _drift_rivals(train, current: Fit, free, best: Candidate, responses, scales) -> list[dict]:
+    """Each generic drift that rivals a member of ``best`` (:func:`~.extensions.drift_rivals`), fitted in that
+    member's place on the current model (every other parameter free again): its BIC against the current model and
+    against ``best``. A rival within :data:`AMBIGUITY_MARGIN` of ``best``, or better, explains the residual about
+    as well with a form outside the catalogue: the data do not single out the mechanism."""
+    out = []
+    for member in best.extensions:
+        others = tuple(e for e in best.extensions if e is not member)
+        base = current.soil if not others else replace(best.fit.soil, **member.off)
+        for field_, condition in drift_rivals(member):
+            rival = drift_rival(field_, condition)
+            start = replace(base, drift_field=field_, drift_condition=condition, drift_rate=0.0)
+            fit = calibrate(train, start, free + tuple(p for e in others for p in e.parameters) + rival.parameters,
+                            responses=responses, scales=scales)
+            out.append({"name": rival.name, "description": rival.mechanism, "replaces": member.name,
+                        "rate": fit.free["drift_rate"], "delta_bic": fit.bic - current.bic,
+                        "bic_vs_accepted": fit.bic - best.fit.bic})
+    return sorted(out, key=lambda r: r["bic_vs_accepted"])
 
 
 def _mid(ext: Extension) -> dict:
@@ -432,6 +454,9 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
                                   (rival.extension,), responses, scales)
             if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems((rival.extension,), joint):
                 unresolved.append(rival.name)
+        if not unresolved:
+            step.rivals = _drift_rivals(train, current, free, best, responses, scales)
+            unresolved = [r["name"] for r in step.rivals if r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
         if unresolved:
             step.ambiguity = [best.name] + unresolved
             break

@@ -66,6 +66,13 @@ class Extension:
     parameters: tuple[Parameter, ...]
     off: dict
     applies: Callable
+    #: the test conditions through which the mechanism acts (its effect grows with them); a name needs the data
+    #: to prefer the mechanism's form to a generic drift of a classical parameter with the same condition
+    #: (:func:`drift_rival`; :mod:`.discovery`)
+    acts_through: tuple[str, ...] = ()
+    #: the (field, condition) drifts that state the mechanism's own physics (slip-sinkage *is* n0 rising with
+    #: slip): these are not rivals of any mechanism
+    drifts: tuple[tuple[str, str], ...] = ()
 
 
 #: Parameters the classical model is calibrated on: every soil parameter of its equations that force and
@@ -112,25 +119,26 @@ EXTENSIONS = {
             "slip_sinkage", "sinkage exponent rising with slip: the wheel digs in as it slips",
             "seed 003 eq. 5, seed 000 eq. 4: n = n0 + n1 |i|",
             (Parameter("n1", -0.3, 1.5, sign=1),), {"n1": 0.0},
-            lambda d: _varies(d.slip),
+            lambda d: _varies(d.slip), ("slip",), (("n0", "slip"),),
         ),
         Extension(
             "theta_m_slip", "angle of maximum normal stress moving forward with slip",
             "seed 003 eq. 8 (Oida; Wong--Reece): theta_m = (a1 + a2 i) theta_f",
             (Parameter("a2", -0.3, 0.6, sign=1),), {"a2": 0.0},
-            lambda d: _varies(d.slip),
+            lambda d: _varies(d.slip), ("slip",), (("a1", "slip"),),
         ),
         Extension(
             "soil_flow", "soil under the rim carried along with it, reducing the shear displacement",
             "seed 000 eq. 8: j = r((theta_f - theta)(1 - v_soil / (r omega)) - (1 - i)(sin theta_f - sin theta))",
             (Parameter("soil_flow", 0.0, 0.9),), {"soil_flow": 0.0},
-            lambda d: _varies(d.slip),
+            lambda d: _varies(d.slip), ("slip",),
         ),
         Extension(
             "sidewall", "passive soil resistance on the wheel's sidewall when it slides sideways",
             "seed 003 eqs. 17--19 (Schwanghart; modified Terzaghi factors)",
             (Parameter("sidewall_scale", 0.0, 10.0),), {"sidewall_scale": 0.0},
             lambda d: bool(np.any(np.abs(d.slip_angle) > 0)) and np.isfinite(d.responses["lateral_force"]).any(),
+            ("slip_angle",),
         ),
         Extension(
             "grouser", "passive earth pressure on the grousers in the soil",
@@ -162,13 +170,14 @@ EXTENSIONS = {
             "seed 003 eq. 23 (Senatore & Sandu 2011): gamma_n = gamma_0 (k1 + k2 n_p), cohesion alike, with k1 = 1 - k2 "
             "(undisturbed soil on the first pass)",
             (Parameter("multipass_k2", 0.0, 1.0),), {"multipass_k2": 0.0},
-            lambda d: _varies(d.passes),
+            # compaction raises density and cohesion; density enters the classical stresses only as rho k'_phi
+            lambda d: _varies(d.passes), ("passes",), (("cohesion", "passes"), ("kphi_prime", "passes")),
         ),
         Extension(
             "gravity_cohesion", "soil strength that falls with gravity (cohesion ~ g^kappa)",
             "seed 000 sec. 5: measured soil strength is lower at reduced gravity",
             (Parameter("cohesion_gravity_exponent", -1.0, 3.0, sign=1),), {"cohesion_gravity_exponent": 0.0},
-            lambda d: _varies(d.gravity),
+            lambda d: _varies(d.gravity), ("gravity",), (("cohesion", "gravity"),),
         ),
         Extension(
             "gravity_pressure", "frictional pressure modulus that does not scale fully with gravity: sinkage "
@@ -179,12 +188,37 @@ EXTENSIONS = {
             # with k'_c free, two gravity levels fix (c k'_c + rho g b k'_phi g^-eps) at both exactly: a third
             # level is needed to tell the exponent from the split between k'_c and k'_phi
             lambda d: np.unique(np.round(np.asarray(d.gravity, float), 6)).size >= 3,
+            ("gravity",), (("kphi_prime", "gravity"),),
         ),
         Extension(
             "gravity_soil_flow", "soil under the rim carried along faster at lower gravity, lowering traction",
             "seed 000 sec. 3.3 and eq. 8: eta(g) = eta_g (1 - g / g0) in j = r((theta_f - theta)(1 - eta) - ...)",
             (Parameter("soil_flow_gravity", 0.0, 0.9),), {"soil_flow_gravity": 0.0},
-            lambda d: _varies(d.gravity),
+            lambda d: _varies(d.gravity), ("gravity",),
         ),
     )
 }
+
+#: Every (field, condition) drift that a catalogue mechanism states: not a rival.
+CATALOGUE_DRIFTS = frozenset(d for e in EXTENSIONS.values() for d in e.drifts)
+#: The range searched for a drift's rate (p (1 + rate u), u of order 1 at the largest condition).
+DRIFT_RATE = Parameter("drift_rate", -1.5, 1.5)
+
+
+def drift_rival(field: str, condition: str) -> Extension:
+    """A generic rival, not a mechanism: the classical parameter ``field`` varying linearly with ``condition``
+    (:data:`~.terramechanics.DRIFT_MEASURES`). Fitted in place of a mechanism that acts through ``condition``: if
+    it explains the residual about as well, the data do not single out the mechanism's form."""
+    return Extension(f"{field} ~ {condition}",
+                     f"{field.replace('_x', '').replace('_', ' ')} varying linearly with "
+                     f"{condition.replace('_', ' ')} (a generic form outside the catalogue)",
+                     "generic drift p (1 + rate u), not a mechanism", (DRIFT_RATE,), {"drift_rate": 0.0},
+                     lambda d: True)
+
+
+def drift_rivals(ext: Extension) -> list[tuple[str, str]]:
+    """The (field, condition) drifts that rival ``ext``: every classical field drifting with each condition the
+    mechanism acts through, except the drifts that are catalogue mechanisms."""
+    from .terramechanics import DRIFT_FIELDS
+
+    return [(f, c) for c in ext.acts_through for f in DRIFT_FIELDS if (f, c) not in CATALOGUE_DRIFTS]

@@ -49,9 +49,21 @@ def verdict_lines(findings: dict) -> list[str]:
                      f"the model still leaves {'; '.join(c['partial_because'])}")
     if not findings["accepted"]:
         lines.append("found: nothing")
-    for group in findings["ambiguities"]:
-        lines.append(f"ambiguous: {' or '.join(group)} explain the same residual about equally well (ΔBIC within "
-                     f"{BIC_MARGIN:g}); the data cannot tell them apart, so neither is named")
+    for step in findings["steps"]:
+        group = step["ambiguity"]
+        if not group:
+            continue
+        rivals = {r["name"]: r for r in step.get("rivals", [])}
+        generic = [rivals[n] for n in group if n in rivals]
+        if generic:
+            alternatives = "; ".join(f"{r['name']}: {r['description']}, ΔBIC {r['bic_vs_accepted']:+.1f} against it"
+                                     for r in generic)
+            lines.append(f"ambiguous: {group[0]} passes every check but is not named, because a generic drift explains "
+                         f"the same residual about as well or better ({alternatives}); the data do not single out "
+                         "the mechanism's form")
+        else:
+            lines.append(f"ambiguous: {' or '.join(group)} explain the same residual about equally well (ΔBIC within "
+                         f"{BIC_MARGIN:g}); the data cannot tell them apart, so neither is named")
     for u in findings["unexplained"]:
         trend = f", Spearman {u['spearman']:+.2f}" if u["spearman"] is not None else ""
         lines.append(f"unexplained: {u['text']} (shares of its systematic residual{trend}, lack-of-fit "
@@ -191,7 +203,9 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
               f"physical range and of the mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of "
               "the systematic residual. When no single mechanism passes and a systematic residual remains, the "
               f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
-              f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone.", ""]
+              f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone. The best passing mechanism "
+              "is named only if no generic drift of a classical parameter with a condition it acts through fits "
+              f"within ΔBIC {BIC_MARGIN:g} of it.", ""]
     for s in findings["steps"]:
         kind = " (pairs, look-ahead)" if s.get("pairs") else ""
         lines += [f"### Step {s['step'] + 1}{kind}: on {' + '.join(['classical'] + s['model'])}", "",
@@ -203,6 +217,13 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
             lines.append(f"| {c['name']} | {params} | {c['gain']:+.4f} ± {c['gain_std']:.4f} | {c['delta_bic']:+.1f} | "
                          f"{100 * c['explained']:.0f} % | {verdict} |")
         lines.append("")
+        if s.get("rivals"):
+            lines += [f"Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
+                      f"it acts through, fitted in its place; within ΔBIC {BIC_MARGIN:g} of it, or better, and it is "
+                      "not named):", "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
+                      "|---|---|---|---|---|"]
+            lines += [f"| {r['description']} | {r['replaces']} | {r['rate']:+.3g} | {r['delta_bic']:+.1f} | "
+                      f"{r['bic_vs_accepted']:+.1f} |" for r in s["rivals"]] + [""]
     if findings["steps"]:
         lines += ["![](candidates.png)", ""]
     if d.skipped:

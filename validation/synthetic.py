@@ -45,6 +45,10 @@ HIDDEN_RANGES = {
 #: Effects the catalogue does not hold (the workflow must not give them a catalogue name): each a soil parameter
 #: that varies with a test condition in a way no extension models, with the range its strength is drawn from.
 #: ``field``: the SoilParameters field it changes; ``law(value, strength, cond)``: the field's value per row.
+#: The first five are linear (or, over two loads, equivalent) drifts of one parameter with one condition, the form
+#: of the workflow's generic rivals (:func:`~.extensions.drift_rival`; the load drifts have no rival, since no
+#: mechanism acts through the load); the last two are outside that family too: a friction angle that rises and
+#: falls again with slip, and one that falls with slip and slip angle together.
 OUT_OF_CATALOGUE = {
     "friction_gravity": {
         "description": "internal friction angle rising at low gravity, phi + d (1 - g / 9.81) (a gravity effect "
@@ -68,6 +72,17 @@ OUT_OF_CATALOGUE = {
                        "(compaction under the wheel's own pressure bulb)",
         "field": "density", "range": (0.3, 0.6),
         "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
+    "friction_slip_peak": {
+        "description": "friction angle mobilised at moderate slip and lost again at large slip, phi + d sin(pi "
+                       "min(|i| / 0.7, 1)) (dilatant peak strength, then loosened soil; not monotone in slip)",
+        "field": "friction_angle", "range": (3.0, 6.0),
+        "law": lambda v, d, c: v + d * np.sin(np.pi * np.minimum(np.abs(c["slip"]) / 0.7, 1.0))},
+    "friction_slip_steering": {
+        "description": "friction angle lost where the wheel both slips and slides sideways, phi - d (|i| / 0.7) "
+                       "(sin|beta| / sin 30 deg) (an interaction of two conditions)",
+        "field": "friction_angle", "range": (6.0, 12.0),
+        "law": lambda v, d, c: v - d * (np.abs(c["slip"]) / 0.7) * (
+            np.sin(np.radians(np.abs(c["slip_angle"]))) / np.sin(np.radians(30.0)))},
 }
 
 

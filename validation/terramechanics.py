@@ -34,6 +34,12 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
   cohesion times k1 + k2 n_p (seed 003 eq. 23, Senatore & Sandu 2011) with k1 = 1 - k2, so that the first
   pass meets undisturbed soil;
 * sinkage z from vertical equilibrium F_z(z) = W (Illinois false position, vectorised over conditions).
+
+A *drift* (``drift_field``, ``drift_condition``, ``drift_rate``) is not a mechanism: it lets one classical soil
+parameter p vary linearly with one test condition, p (1 + rate u), u the condition's own measure
+(:data:`DRIFT_MEASURES`). The discovery workflow fits drifts as generic rivals of a mechanism that acts through
+the same condition (:mod:`wheelsoil.validation.discovery`): a mechanism is named only when the data single out
+its form, not merely "some soil property changes with slip".
 """
 
 from dataclasses import asdict, dataclass
@@ -47,6 +53,21 @@ from wheelsoil.gravity import EARTH_GRAVITY
 #: Gauss--Legendre nodes per contact region (front and rear of theta_m); 48 integrate the smooth stress
 #: profiles to better than 1e-8 relative (see tests/test_validation_terramechanics.py).
 QUADRATURE_POINTS = 48
+
+#: Classical soil parameters a drift may act on. The drifted value enters the Wong--Reece and Janosi--Hanamoto
+#: stresses (normal stress, shear strength and displacement, theta_m); the sidewall, bulldozing and grouser terms
+#: keep the soil's own value.
+DRIFT_FIELDS = ("cohesion", "friction_angle", "shear_modulus_x", "kc_prime", "kphi_prime", "n0", "a1")
+#: The measure u of each condition a drift is linear in, u = 0 at the reference state: |slip|, sin|slip angle|,
+#: the fall in gravity 1 - g / 9.81, and the earlier passes n_p - 1.
+DRIFT_MEASURES = {
+    "slip": lambda i, beta, g, n_p: np.abs(i),
+    "slip_angle": lambda i, beta, g, n_p: np.abs(np.sin(beta)),
+    "gravity": lambda i, beta, g, n_p: 1.0 - g / EARTH_GRAVITY,
+    "passes": lambda i, beta, g, n_p: n_p - 1.0,
+}
+#: A drifted parameter is held at this fraction of its value or more (1 + rate u >= DRIFT_FLOOR).
+DRIFT_FLOOR = 0.05
 
 def _positive(name: str, value: float, *, allow_zero: bool = False) -> None:
     ok = np.isfinite(value) and (value >= 0.0 if allow_zero else value > 0.0)
@@ -116,6 +137,11 @@ class SoilParameters:
     multipass_k2: float = 0.0
     kphi_gravity_exponent: float = 0.0
     soil_flow_gravity: float = 0.0
+    #: a generic drift (module docstring): field of :data:`DRIFT_FIELDS`, condition of :data:`DRIFT_MEASURES`
+    #: and rate [-] of p (1 + rate u); "" / 0 for none
+    drift_field: str = ""
+    drift_condition: str = ""
+    drift_rate: float = 0.0
 
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
@@ -140,8 +166,25 @@ class SoilParameters:
                 f"a1 = {self.a1!r}, a2 = {self.a2!r} put theta_m outside the contact: allowed 0 <= a1 < 1 and "
                 f"0 <= a1 + a2 <= 1")
 
+        if self.drift_field not in ("",) + DRIFT_FIELDS:
+            raise WheelsoilInputError(f"drift_field = {self.drift_field!r}: allowed {list(DRIFT_FIELDS)} or ''")
+        if self.drift_condition not in ("",) + tuple(DRIFT_MEASURES):
+            raise WheelsoilInputError(
+                f"drift_condition = {self.drift_condition!r}: allowed {list(DRIFT_MEASURES)} or ''")
+        if not np.isfinite(self.drift_rate) or (self.drift_rate and not (self.drift_field and self.drift_condition)):
+            raise WheelsoilInputError(f"drift_rate = {self.drift_rate!r} needs a drift_field and a drift_condition")
+
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def drifted(self, name: str, i, beta, g, n_p):
+        """The value of field ``name`` per condition (slip i, slip angle beta [rad], gravity g, pass n_p): the
+        soil's own unless the drift acts on it, then p max(1 + rate u, :data:`DRIFT_FLOOR`)."""
+        value = getattr(self, name)
+        if name != self.drift_field or not self.drift_rate:
+            return value
+        u = DRIFT_MEASURES[self.drift_condition](i, beta, g, n_p)
+        return value * np.maximum(1.0 + self.drift_rate * u, DRIFT_FLOOR)
 
 
 @dataclass(frozen=True)
@@ -218,16 +261,20 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         *(np.asarray(v, float) for v in (sinkage, slip, slip_angle, gravity, extra_pressure, passes))))
     beta = np.radians(beta_deg)
     r, b = effective_radius(soil, wheel), wheel.width
-    phi = np.radians(soil.friction_angle)
+    drifted = lambda name: soil.drifted(name, i, beta, g, n_p)  # noqa: E731  (the soil's own unless drifting)
+    phi = np.radians(drifted("friction_angle"))
     compaction = 1.0 + soil.multipass_k2 * (n_p - 1.0)  # seed 003 eq. 23 with k1 = 1 - k2
     density = soil.density * compaction
     cohesion = soil.cohesion * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
+    strength_cohesion = drifted("cohesion") * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
     theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
-    theta_m = np.clip(soil.a1 + soil.a2 * i, 0.0, 1.0) * theta_f
+    theta_m = np.clip(drifted("a1") + soil.a2 * i, 0.0, 1.0) * theta_f
     theta_r = -soil.c3 * theta_f
-    n = soil.n0 + soil.n1 * np.abs(i)
-    kphi = soil.kphi_prime * (g / EARTH_GRAVITY) ** (-soil.kphi_gravity_exponent)  # 0: Reece (seed 000 eq. 3)
-    k_pressure = (cohesion * soil.kc_prime + density * g * b * kphi) * (r / b) ** n
+    n = drifted("n0") + soil.n1 * np.abs(i)
+    kphi = drifted("kphi_prime") * (g / EARTH_GRAVITY) ** (-soil.kphi_gravity_exponent)  # 0: Reece (seed 000 eq. 3)
+    k_pressure = (strength_cohesion * drifted("kc_prime") + density * g * b * kphi) * (r / b) ** n
+    shear_modulus = drifted("shear_modulus_x")  # k_y = k_x when k_x drifts (tied, as calibrated)
+    shear_modulus_y = shear_modulus if soil.drift_field == "shear_modulus_x" else soil.shear_modulus_y
 
     x, w = gauss_legendre()
     th_front, w_front = _gauss(theta_m, theta_f, x, w)
@@ -248,8 +295,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     sweep = (tf - theta) * (1.0 - eta[:, None])
     jx = np.where(driving, r * (sweep - (1.0 - i[:, None]) * (np.sin(tf) - np.sin(theta))),
                   r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
-    strength = cohesion[:, None] + sigma * np.tan(phi)
-    tau_x = strength * (1.0 - np.exp(-jx / soil.shear_modulus_x))
+    strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
+    tau_x = strength * (1.0 - np.exp(-jx / np.broadcast_to(shear_modulus, i.shape)[:, None]))
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
     grousers = bool(wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0)
     if grousers:
@@ -259,7 +306,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         return {"vertical_force": fz}
     jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
     jy = jy * np.abs(np.tan(beta))[:, None]
-    tau_y = strength * (1.0 - np.exp(-jy / soil.shear_modulus_y))
+    tau_y = strength * (1.0 - np.exp(-jy / np.broadcast_to(shear_modulus_y, i.shape)[:, None]))
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
