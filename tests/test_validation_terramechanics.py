@@ -7,7 +7,9 @@ import pytest
 from scipy.integrate import quad
 
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.validation.extensions import BASELINE_OFF
 from wheelsoil.validation.terramechanics import (
+    DRIFT_FLOOR,
     RigidWheel,
     SoilParameters,
     bearing_capacity_factors,
@@ -243,3 +245,38 @@ def test_gravity_soil_flow_is_the_soil_flow_of_seed000_eq8_at_each_gravity():
     for q in ("drawbar_pull", "torque", "sinkage"):
         assert moon[q] == pytest.approx(same[q], rel=1e-12), q
     assert moon["drawbar_pull"] < predict(SAND, WHEEL, slip=0.3, load=60.0, gravity=1.62)["drawbar_pull"]
+
+
+@pytest.mark.parametrize("field, condition", [("cohesion", "slip"), ("friction_angle", "slip_angle"),
+                                              ("shear_modulus_x", "gravity"), ("n0", "passes"), ("a1", "gravity"),
+                                              ("kc_prime", "slip"), ("kphi_prime", "passes")])
+def test_a_drift_is_the_soil_of_each_condition_with_its_own_parameter(field, condition):
+    """A drift p max(1 + rate u, floor) is exactly the model run condition by condition with p set to that value (u = |i|,
+    sin|beta|, 1 - g / 9.81, n_p - 1); rate 0 is the soil without a drift, bit for bit. On the classical model:
+    the sidewall, bulldozing and grouser terms keep the soil's own value (documented)."""
+    soil = replace(SAND, **BASELINE_OFF)
+    cond = dict(slip=np.array([0.05, 0.3, 0.6]), slip_angle=np.array([0.0, 10.0, 25.0]), load=60.0,
+                gravity=np.array([9.81, 3.71, 1.62]), passes=np.array([1.0, 2.0, 3.0]))
+    u = {"slip": np.abs(cond["slip"]), "slip_angle": np.sin(np.radians(cond["slip_angle"])),
+         "gravity": 1.0 - cond["gravity"] / 9.81, "passes": cond["passes"] - 1.0}[condition]
+    rate = -0.6
+    drifted = predict(replace(soil, drift_field=field, drift_condition=condition, drift_rate=rate), WHEEL, **cond)
+    for k in range(3):
+        value = getattr(soil, field) * max(1.0 + rate * u[k], DRIFT_FLOOR)  # held above the floor
+        changes = {field: value, **({"shear_modulus_y": value} if field == "shear_modulus_x" else {})}
+        one = predict(replace(soil, **changes), WHEEL, **{q: (v[k] if np.ndim(v) else v) for q, v in cond.items()})
+        for q in ("drawbar_pull", "lateral_force", "sinkage", "torque"):
+            assert drifted[q][k] == pytest.approx(float(one[q]), rel=1e-12, abs=1e-12), (q, k)
+    still = predict(replace(SAND, drift_field=field, drift_condition=condition), WHEEL, **cond)
+    plain = predict(SAND, WHEEL, **cond)  # with every extension on
+    for q in ("drawbar_pull", "lateral_force", "sinkage", "torque"):
+        assert np.array_equal(still[q], plain[q]), q
+
+
+def test_bad_drifts_name_the_key():
+    with pytest.raises(WheelsoilInputError, match="drift_field = 'density'"):
+        SoilParameters(drift_field="density", drift_condition="slip", drift_rate=0.1)
+    with pytest.raises(WheelsoilInputError, match="drift_condition = 'load'"):
+        SoilParameters(drift_field="cohesion", drift_condition="load", drift_rate=0.1)
+    with pytest.raises(WheelsoilInputError, match="drift_rate = 0.1 needs a drift_field"):
+        SoilParameters(drift_rate=0.1)

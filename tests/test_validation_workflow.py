@@ -6,6 +6,7 @@ import os
 import pytest
 
 from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
+from wheelsoil.validation.discovery import RIVAL_MARGIN
 from wheelsoil.validation.extensions import EXTENSIONS
 from wheelsoil.validation.workflow import validate
 
@@ -43,6 +44,11 @@ def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
             assert all(type(v) is bool for v in c["checks"].values())
     report = (out / "report.md").read_text()
     assert "Hidden: slip_sinkage" in report
+    # named only after its generic rivals (a classical parameter drifting with slip) were fitted and fell short
+    rivals = findings["steps"][0]["rivals"]
+    assert {r["name"] for r in rivals} == {"cohesion ~ slip", "friction_angle ~ slip", "shear_modulus_x ~ slip",
+                                           "kc_prime ~ slip", "kphi_prime ~ slip"}
+    assert all(r["bic_vs_accepted"] >= -RIVAL_MARGIN for r in rivals) and "Generic rivals" in report
     # one truth: the terminal, the report's verdict and the JSON name the same mechanisms
     terminal = capsys.readouterr().out
     verdict = report.split("## Verdict")[1].split("##")[0]

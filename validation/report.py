@@ -59,8 +59,8 @@ def verdict_lines(findings: dict) -> list[str]:
             alternatives = "; ".join(f"{r['name']}: {r['description']}, ΔBIC {r['bic_vs_accepted']:+.1f} against it"
                                      for r in generic)
             lines.append(f"ambiguous: {group[0]} passes every check but is not named, because a generic drift explains "
-                         f"the same residual about as well or better ({alternatives}); the data do not single out "
-                         "the mechanism's form")
+                         f"the same residual better ({alternatives}); the data prefer another form to the "
+                         "mechanism's")
         else:
             lines.append(f"ambiguous: {' or '.join(group)} explain the same residual about equally well (ΔBIC within "
                          f"{BIC_MARGIN:g}); the data cannot tell them apart, so neither is named")
@@ -205,7 +205,7 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
               f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
               f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone. The best passing mechanism "
               "is named only if no generic drift of a classical parameter with a condition it acts through fits "
-              f"within ΔBIC {BIC_MARGIN:g} of it.", ""]
+              "better (lower BIC) in its place.", ""]
     for s in findings["steps"]:
         kind = " (pairs, look-ahead)" if s.get("pairs") else ""
         lines += [f"### Step {s['step'] + 1}{kind}: on {' + '.join(['classical'] + s['model'])}", "",
@@ -218,9 +218,9 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
                          f"{100 * c['explained']:.0f} % | {verdict} |")
         lines.append("")
         if s.get("rivals"):
-            lines += [f"Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
-                      f"it acts through, fitted in its place; within ΔBIC {BIC_MARGIN:g} of it, or better, and it is "
-                      "not named):", "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
+            lines += [("Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
+                       "it acts through, fitted in its place; one with a lower BIC, a negative last column, and the "
+                       "mechanism is not named):"), "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
                       "|---|---|---|---|---|"]
             lines += [f"| {r['description']} | {r['replaces']} | {r['rate']:+.3g} | {r['delta_bic']:+.1f} | "
                       f"{r['bic_vs_accepted']:+.1f} |" for r in s["rivals"]] + [""]
