@@ -11,7 +11,16 @@ import numpy as np
 
 from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
-from .discovery import BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, PAIR_POOL, Discovery, model_responses
+from .discovery import (
+    AMBIGUITY_MARGIN,
+    BIC_MARGIN,
+    GAIN_SIGMAS,
+    MIN_EXPLAINED,
+    PAIR_POOL,
+    RIVAL_MARGIN,
+    Discovery,
+    model_responses,
+)
 from .measured import Measurements
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
@@ -43,6 +52,11 @@ def verdict_lines(findings: dict) -> list[str]:
         lines.append(f"found: {c['name']} ({params}; step {c['step'] + 1}, ΔBIC {c['delta_bic']:+.1f}, held-out gain "
                      f"{c['gain']:+.4f} ± {c['gain_std']:.4f}, removes {100 * c['explained']:.0f} % of the systematic "
                      f"residual) — {c['source']}")
+        close = [r for r in findings["steps"][c["step"]].get("rivals", []) if r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
+        if close:
+            lines.append(f"  but a generic drift fits about as well in its place: "
+                         + "; ".join(f"{r['description']} (ΔBIC {r['bic_vs_accepted']:+.1f} against it)" for r in close)
+                         + f"; named because no drift fits better by more than {RIVAL_MARGIN:g}")
     for c in findings["partial"]:
         lines.append(f"partial: {c['name']} was accepted by the selection (ΔBIC {c['delta_bic']:+.1f}, removes "
                      f"{100 * c['explained']:.0f} % of the systematic residual) but is not named as the cause: with it "
@@ -205,7 +219,7 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
               f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
               f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone. The best passing mechanism "
               "is named only if no generic drift of a classical parameter with a condition it acts through fits "
-              "better (lower BIC) in its place.", ""]
+              f"better in its place (BIC lower by more than {RIVAL_MARGIN:g}).", ""]
     for s in findings["steps"]:
         kind = " (pairs, look-ahead)" if s.get("pairs") else ""
         lines += [f"### Step {s['step'] + 1}{kind}: on {' + '.join(['classical'] + s['model'])}", "",
@@ -219,8 +233,8 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
         lines.append("")
         if s.get("rivals"):
             lines += [("Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
-                       "it acts through, fitted in its place; one with a lower BIC, a negative last column, and the "
-                       "mechanism is not named):"), "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
+                       f"it acts through, fitted in its place; one lower than the mechanism by more than {RIVAL_MARGIN:g} "
+                       "in the last column, and the mechanism is not named):"), "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
                       "|---|---|---|---|---|"]
             lines += [f"| {r['description']} | {r['replaces']} | {r['rate']:+.3g} | {r['delta_bic']:+.1f} | "
                       f"{r['bic_vs_accepted']:+.1f} |" for r in s["rivals"]] + [""]
