@@ -152,10 +152,10 @@ def test_generic_rivals_are_drifts_no_mechanism_states():
     """A mechanism's rivals are the classical parameters drifting with each condition it acts through, less the
     drifts that are catalogue mechanisms (n0 with slip is slip-sinkage, a1 with slip is theta_m_slip): a mechanism
     is never its own rival, and mechanisms with no single condition (grousers, radius) have none."""
+    assert all(f in DRIFT_FIELDS and c in DRIFT_MEASURES for f, c in CATALOGUE_DRIFTS)
     for name, ext in EXTENSIONS.items():
         rivals = drift_rivals(ext)
         assert set(ext.drifts) <= set(CATALOGUE_DRIFTS)
-        assert all(f in DRIFT_FIELDS and c in DRIFT_MEASURES for f, c in CATALOGUE_DRIFTS)
         assert not set(rivals) & CATALOGUE_DRIFTS, name
         assert {c for _, c in rivals} <= set(ext.acts_through), name
         assert all(c in DRIFT_MEASURES for c in ext.acts_through), name

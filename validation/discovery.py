@@ -35,9 +35,9 @@ there, instead of picking one. The best passing mechanism must also beat its **g
 (:func:`~.extensions.drift_rivals`), fitted in its place. A rival whose BIC is lower by more than
 :data:`RIVAL_MARGIN` explains the residual better with a form outside the catalogue ("some soil property changes
 with slip"): the mechanism is not named, the step reports an ambiguity between it and the rival, and selection
-stops. A weak effect of an unknown
-form otherwise takes the name of the nearest catalogue mechanism (docs/validation/campaigns.md: cohesion softening
-with slip named ``theta_m_slip``). What the final model still leaves systematic is reported as **unexplained**
+stops. A weak effect of an unknown form otherwise takes the name of the nearest catalogue mechanism
+(docs/validation/campaigns.md: cohesion softening with slip named ``theta_m_slip``). What the final model still
+leaves systematic is reported as **unexplained**
 (:func:`~.residuals.unexplained_trends`), and an accepted mechanism that moves a response where a systematic
 residual remains is reported as a **partial** explanation, not named as the cause: the misfit has a form the
 mechanism does not hold. Residuals are normalised per response by the training data's spread.
@@ -64,8 +64,8 @@ from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
 from .terramechanics import SoilParameters
 
-__all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "RIVAL_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "PAIR_POOL", "RESPONSES",
-           "Candidate",
+__all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "PAIR_POOL", "RESPONSES",
+           "RIVAL_MARGIN", "Candidate",
            "Discovery", "Fit", "Step", "discover", "holdout_mask", "mechanism_effect", "model_responses",
            "normalised_residuals", "response_scales"]
 

@@ -16,6 +16,8 @@ from typing import Callable
 
 import numpy as np
 
+from .terramechanics import DRIFT_FIELDS
+
 
 @dataclass(frozen=True)
 class Parameter:
@@ -208,7 +210,8 @@ DRIFT_RATE = Parameter("drift_rate", -1.5, 1.5)
 def drift_rival(field: str, condition: str) -> Extension:
     """A generic rival, not a mechanism: the classical parameter ``field`` varying linearly with ``condition``
     (:data:`~.terramechanics.DRIFT_MEASURES`). Fitted in place of a mechanism that acts through ``condition``: if
-    it explains the residual about as well, the data do not single out the mechanism's form."""
+    it explains the residual better (:data:`~.discovery.RIVAL_MARGIN`), the data prefer another form to the
+    mechanism's."""
     return Extension(f"{field} ~ {condition}",
                      f"{field.replace('_x', '').replace('_', ' ')} varying linearly with "
                      f"{condition.replace('_', ' ')} (a generic form outside the catalogue)",
@@ -219,6 +222,4 @@ def drift_rival(field: str, condition: str) -> Extension:
 def drift_rivals(ext: Extension) -> list[tuple[str, str]]:
     """The (field, condition) drifts that rival ``ext``: every classical field drifting with each condition the
     mechanism acts through, except the drifts that are catalogue mechanisms."""
-    from .terramechanics import DRIFT_FIELDS
-
     return [(f, c) for c in ext.acts_through for f in DRIFT_FIELDS if (f, c) not in CATALOGUE_DRIFTS]

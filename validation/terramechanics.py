@@ -266,7 +266,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     compaction = 1.0 + soil.multipass_k2 * (n_p - 1.0)  # seed 003 eq. 23 with k1 = 1 - k2
     density = soil.density * compaction
     cohesion = soil.cohesion * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
-    strength_cohesion = drifted("cohesion") * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
+    strength_cohesion = (drifted("cohesion") * (g / EARTH_GRAVITY) ** soil.cohesion_gravity_exponent * compaction
+                         if soil.drift_field == "cohesion" else cohesion)  # the stresses' cohesion
     theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
     theta_m = np.clip(drifted("a1") + soil.a2 * i, 0.0, 1.0) * theta_f
     theta_r = -soil.c3 * theta_f
