@@ -19,6 +19,8 @@ from pathlib import Path
 from wheelsoil.gravity import GRAVITY_PRESETS
 from wheelsoil.parameters import smoke
 
+from . import soil_lab_command
+
 EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
 MAIN_HELP = """\
@@ -342,6 +344,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "(slip_angle, load, gravity, slip, passes, grouser_height, group) held out in turn; writes "
                         "crossval.md and crossval.json to --report")
     p.set_defaults(func=cmd_validate)
+
+    soil_lab_command.add_parser(sub)
 
     p = sub.add_parser("predict", help="predict measured conditions with a model saved by 'wheelsoil validate'",
                        description="Rebuild the calibrated model from MODEL (the model.json that 'wheelsoil validate' "

@@ -1,0 +1,240 @@
+"""Plate sinkage and static wheel sinkage: a rigid plate or wheel pressed into a prepared bed at constant speed, the
+soil's vertical reaction recorded against sinkage (the CMU lab's force--displacement tests).
+
+Protocol: the bed (:func:`wheelsoil.granular.prepare_bed`, cached) in its walled bin; the tool placed centred over
+the bin, a quarter of the smallest particle above the highest sphere beneath it; moved down at ``speed``; one
+sample every ``sample_interval`` of travel, each the mean soil force over the DEM steps in it. Sinkage is measured
+from the bed's surface under the tool (the mean over d_max-wide columns of the highest sphere tops inside the
+footprint): on sand of real grains the lab's zero, the first contact of the plate, is that surface to within about
+0.7 mm (data README); on coarse spheres the first contact would sit up to a particle radius higher.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, from_parameters
+from wheelsoil.granular.bed import Bed, BedSpec, prepare_bed
+from wheelsoil.granular.materials import STEEL, PairProperties
+from wheelsoil.parameters import cmu_k10
+
+from .measured import LoadCurve, plate_area
+from .rigid import RigidTool
+from .shapes import disc
+from .specs import PlateSpec, WheelPressSpec, check_plate_fits, check_resolution, inertial_number
+
+
+@dataclass
+class PenetrationResult:
+    """A simulated pressing test: the curve, where it ran and what it cost.
+
+    curve: force against sinkage (:class:`~.measured.LoadCurve`); surface: the zero of sinkage [m];
+    bulk_density: the bed's [kg/m^3]; packing_fraction; particles; inertial_number at the deepest sample (the
+    flow is quasi-static below about 1e-3); wall_seconds; steps; time_step [s]; bed_seconds: preparing the bed
+    (0 when it came from the cache).
+    """
+
+    curve: LoadCurve
+    surface: float
+    bulk_density: float
+    packing_fraction: float
+    particles: int
+    inertial_number: float
+    wall_seconds: float
+    steps: int
+    time_step: float
+    bed_seconds: float = 0.0
+    meta: dict = field(default_factory=dict)
+
+
+def footprint_surface(bed: Bed, center_xy, half_x: float, half_y: float) -> tuple[float, float]:
+    """(mean surface, highest sphere top) [m] inside the rectangle ``center_xy`` +- (half_x, half_y): the surface
+    is the mean over d_max-wide columns of each column's highest sphere top."""
+    x, r = bed.positions, bed.radii
+    d = bed.spec.diameter_max
+    lo = np.asarray(center_xy, float) - (half_x, half_y)
+    inside = np.all((x[:, :2] >= lo) & (x[:, :2] <= lo + (2 * half_x, 2 * half_y)), axis=1)
+    if not inside.any():
+        raise WheelsoilInputError("no sphere lies under the tool's footprint: the bed is empty there")
+    top = x[inside, 2] + r[inside]
+    cols = np.floor((x[inside, :2] - lo) / d).astype(np.int64)
+    key = cols[:, 0] * 100_000 + cols[:, 1]
+    highest = {}
+    for k, h in zip(key.tolist(), top.tolist()):
+        if h > highest.get(k, -math.inf):
+            highest[k] = h
+    return float(np.mean(list(highest.values()))), float(top.max())
+
+
+def _press(bed: Bed, tool: RigidTool, bottom_offset: float, surface: float, speed: float, max_sinkage: float,
+           sample_interval: float, progress: bool, label: str) -> tuple[np.ndarray, np.ndarray, int]:
+    """Move ``tool`` down at ``speed`` until its lowest point is ``max_sinkage`` below ``surface``; returns the
+    sinkage [m] and the soil's vertical force [N] of every sample and the steps taken."""
+    scene = tool.scene
+    dt = scene.time_step
+    steps = max(1, int(round(sample_interval / speed / dt)))
+    tool.move((0.0, 0.0, -speed))
+    tool.soil_force()
+    sinkage, force = [], []
+    depth_at = lambda: surface - (tool.position[2] + bottom_offset)  # noqa: E731
+    total = max_sinkage - depth_at()
+    bar = _Bar(label, total) if progress else None
+    try:
+        while depth_at() < max_sinkage:
+            scene.step(steps)
+            sinkage.append(depth_at() - 0.5 * steps * dt * speed)  # the sample's mean position
+            force.append(float(tool.soil_force()[2]))
+            if bar is not None:
+                bar.advance(steps * dt * speed)
+    finally:
+        if bar is not None:
+            bar.stop()
+    tool.hold()
+    return np.asarray(sinkage), np.asarray(force), len(sinkage) * steps
+
+
+class _Bar:
+    """A rich progress bar over the tool's travel [m]."""
+
+    def __init__(self, label: str, total: float) -> None:
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+        self.progress = Progress(TextColumn(label), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                                 TimeElapsedColumn(), TimeRemainingColumn(), transient=True)
+        self.task = self.progress.add_task(label, total=max(total, 1e-9))
+        self.progress.start()
+
+    def advance(self, amount: float) -> None:
+        self.progress.advance(self.task, amount)
+
+    def stop(self) -> None:
+        self.progress.stop()
+
+
+def _bed(bed_spec: BedSpec, cache_dir, arch) -> tuple[Bed, float]:
+    start = time.perf_counter()
+    bed = prepare_bed(bed_spec, cache_dir=cache_dir, arch=arch)
+    return bed, (0.0 if bed.meta.get("from_cache") else time.perf_counter() - start)
+
+
+def _result(bed: Bed, curve: LoadCurve, surface: float, speed: float, footprint: float, loaded_area: float,
+            tool: RigidTool, steps: int, wall: float, bed_seconds: float) -> PenetrationResult:
+    """The result record; the inertial number at the deepest sample, with the strain rate speed / footprint and the
+    pressure the force over ``loaded_area`` [m^2] (at least the overburden of one particle layer)."""
+    s = bed.spec
+    d_mean = 0.5 * (s.diameter_min + s.diameter_max)
+    bulk = bed.packing_fraction * s.material.density
+    deepest = max(float(curve.force[-1]), 1e-9) / loaded_area
+    rate = speed / footprint
+    inertial = inertial_number(rate, d_mean, max(deepest, bulk * s.gravity_magnitude * d_mean), s.material.density)
+    return PenetrationResult(curve, surface, bulk, bed.packing_fraction, bed.n_particles, inertial, wall, steps,
+                             tool.scene.time_step, bed_seconds)
+
+
+def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | None = None, cache_dir=None,
+               arch: str | None = None, progress: bool = False) -> PenetrationResult:
+    """Press a rigid circular plate into the bed of ``bed_spec`` (checked before any work: the plate inside the
+    box, enough particles across it)."""
+    check_plate_fits("plate diameter", plate.diameter, bed_spec.length, bed_spec.width)
+    check_resolution("plate diameter", plate.diameter, bed_spec.diameter_max)
+    bed, bed_seconds = _bed(bed_spec, cache_dir, arch)
+    start = time.perf_counter()
+    center = np.array([0.5 * bed_spec.length, 0.5 * bed_spec.width])
+    radius = 0.5 * plate.diameter
+    surface, highest = footprint_surface(bed, center, radius, radius)
+    nodes, tri = disc(radius, plate.rings)
+    gap = 0.25 * bed_spec.diameter_min
+    z0 = highest + 0.5 * plate.thickness + gap
+    scene = bed.to_scene(headroom=max(plate.max_sinkage, 0.05), arch=arch)
+    tool = RigidTool(scene, nodes + (center[0], center[1], z0), tri, plate.thickness,
+                     pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL)
+    sinkage, force, steps = _press(bed, tool, -0.5 * plate.thickness, surface, plate.speed, plate.max_sinkage,
+                                   plate.sample_interval, progress, f"plate {1e3 * plate.diameter:g} mm")
+    curve = LoadCurve("plate", plate.diameter, f"DEM, {1e3 * plate.diameter:g} mm plate, seed {bed_spec.seed}",
+                      sinkage, force, area=plate_area(plate.diameter))
+    return _result(bed, curve, surface, plate.speed, plate.diameter, plate.area, tool, steps,
+                   time.perf_counter() - start, bed_seconds)
+
+
+def cmu_wheel(name: str, element_size: float | None = None) -> WheelGeometry:
+    """The CMU K10-mini wheel ``"smooth"`` or ``"grouser"`` (:data:`wheelsoil.parameters.cmu_k10.K10_MINI_WHEELS`)."""
+    values = dict(cmu_k10.K10_MINI_WHEELS[name])
+    if element_size is not None:
+        values["element_size"] = element_size
+    return from_parameters(values)
+
+
+def wheel_press_test(bed_spec: BedSpec, press: WheelPressSpec, *, pair: PairProperties | None = None,
+                     cache_dir=None, arch: str | None = None, progress: bool = False) -> PenetrationResult:
+    """Press a rigid CMU wheel, axle along y, straight down into the bed of ``bed_spec``."""
+    wheel = cmu_wheel(press.wheel, press.element_size)
+    outer = wheel.radius + wheel.grouser_height
+    check_plate_fits("wheel diameter", 2 * outer, bed_spec.length, bed_spec.length)
+    check_plate_fits("wheel width", wheel.width, bed_spec.width, bed_spec.width)
+    check_resolution("wheel width", wheel.width, bed_spec.diameter_max)
+    bed, bed_seconds = _bed(bed_spec, cache_dir, arch)
+    start = time.perf_counter()
+    mesh, _ = build_wheel_mesh(wheel)
+    surface_facets = mesh.surface if mesh.surface is not None else np.arange(len(mesh.triangles))
+    center = np.array([0.5 * bed_spec.length, 0.5 * bed_spec.width])
+    chord = math.sqrt(max(outer**2 - (outer - press.max_sinkage) ** 2, 0.0))
+    surface, _ = footprint_surface(bed, center, max(chord, bed_spec.diameter_max), 0.5 * wheel.width)
+    _, highest = footprint_surface(bed, center, outer, 0.5 * wheel.width)
+    gap = 0.25 * bed_spec.diameter_min
+    lowest = float(mesh.nodes[:, 2].min()) - 0.5 * wheel.grouser_thickness if wheel.grouser_count else \
+        float(mesh.nodes[:, 2].min()) - 0.5 * wheel.tread_thickness
+    z0 = highest - lowest + gap
+    scene = bed.to_scene(headroom=2 * outer, arch=arch)
+    tri = mesh.triangles[surface_facets]
+    used = np.unique(tri)
+    renumber = np.full(len(mesh.nodes), -1, np.int64)
+    renumber[used] = np.arange(used.size)
+    thickness = np.asarray(mesh.thickness)[surface_facets] if np.ndim(mesh.thickness) else mesh.thickness
+    tool = RigidTool(scene, mesh.nodes[used] + (center[0], center[1], z0), renumber[tri], thickness,
+                     pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL,
+                     center=(center[0], center[1], z0))
+    sinkage, force, steps = _press(bed, tool, lowest, surface, press.speed, press.max_sinkage, press.sample_interval,
+                                   progress, f"{press.wheel} wheel")
+    curve = LoadCurve("wheel", wheel.radius, f"DEM, {press.wheel} wheel, seed {bed_spec.seed}", sinkage, force,
+                      wheel=press.wheel)
+    return _result(bed, curve, surface, press.speed, wheel.width, 2 * chord * wheel.width, tool, steps,
+                   time.perf_counter() - start, bed_seconds)
+
+
+@dataclass(frozen=True)
+class RestingPlate:
+    """A plate left to rest on the bed under gravity: its weight [N], the soil's mean vertical force on it over the
+    last half of the rest [N], and how far it sank [m]."""
+
+    weight: float
+    soil_force: float
+    settlement: float
+
+
+def resting_plate(bed_spec: BedSpec, plate: PlateSpec, *, mass: float, rest_time: float = 0.1,
+                  pair: PairProperties | None = None, cache_dir=None, arch: str | None = None) -> RestingPlate:
+    """Lay a plate of ``mass`` [kg] on the bed, free to sink under gravity, and hold its weight against the soil's
+    force (the check that the soil carries what rests on it: equal to within the rest's remaining motion)."""
+    check_plate_fits("plate diameter", plate.diameter, bed_spec.length, bed_spec.width)
+    check_resolution("plate diameter", plate.diameter, bed_spec.diameter_max)
+    bed, _ = _bed(bed_spec, cache_dir, arch)
+    center = np.array([0.5 * bed_spec.length, 0.5 * bed_spec.width])
+    radius = 0.5 * plate.diameter
+    _, highest = footprint_surface(bed, center, radius, radius)
+    nodes, tri = disc(radius, plate.rings)
+    z0 = highest + 0.5 * plate.thickness + 0.1 * bed_spec.diameter_min
+    scene = bed.to_scene(headroom=0.05, arch=arch)
+    tool = RigidTool(scene, nodes + (center[0], center[1], z0), tri, plate.thickness, pair or bed_spec.wall_pair,
+                     material=bed_spec.wall_material or STEEL, gravity=bed_spec.gravity, mass=mass)
+    tool.move((0.0, 0.0, 0.0), free_z=True)
+    steps = int(math.ceil(0.5 * rest_time / scene.time_step))
+    scene.step(steps)
+    tool.soil_force()
+    scene.step(steps)
+    weight = tool.mass * bed_spec.gravity_magnitude
+    return RestingPlate(weight, float(tool.soil_force()[2]), z0 - float(tool.position[2]))
