@@ -33,7 +33,9 @@ from .specs import PlateSpec, WheelPressSpec, check_plate_fits, check_resolution
 class PenetrationResult:
     """A simulated pressing test: the curve, where it ran and what it cost.
 
-    curve: force against sinkage (:class:`~.measured.LoadCurve`); surface: the zero of sinkage [m];
+    curve: force against sinkage (:class:`~.measured.LoadCurve`); surface: the zero of sinkage [m]; top_offset: how
+    far the highest sphere top under the footprint stands above it [m] (the tool touches the first sphere at
+    sinkage -top_offset; on coarse spheres about a diameter);
     bulk_density: the bed's [kg/m^3]; packing_fraction; particles; inertial_number at the deepest sample (the
     flow is quasi-static below about 1e-3); wall_seconds; steps; time_step [s]; bed_seconds: preparing the bed
     (0 when it came from the cache).
@@ -41,6 +43,7 @@ class PenetrationResult:
 
     curve: LoadCurve
     surface: float
+    top_offset: float
     bulk_density: float
     packing_fraction: float
     particles: int
@@ -122,7 +125,8 @@ def _bed(bed_spec: BedSpec, cache_dir, arch) -> tuple[Bed, float]:
     return bed, (0.0 if bed.meta.get("from_cache") else time.perf_counter() - start)
 
 
-def _result(bed: Bed, curve: LoadCurve, surface: float, speed: float, footprint: float, loaded_area: float,
+def _result(bed: Bed, curve: LoadCurve, surface: float, highest: float, speed: float, footprint: float,
+            loaded_area: float,
             tool: RigidTool, steps: int, wall: float, bed_seconds: float) -> PenetrationResult:
     """The result record; the inertial number at the deepest sample, with the strain rate speed / footprint and the
     pressure the force over ``loaded_area`` [m^2] (at least the overburden of one particle layer)."""
@@ -132,7 +136,7 @@ def _result(bed: Bed, curve: LoadCurve, surface: float, speed: float, footprint:
     deepest = max(float(curve.force[-1]), 1e-9) / loaded_area
     rate = speed / footprint
     inertial = inertial_number(rate, d_mean, max(deepest, bulk * s.gravity_magnitude * d_mean), s.material.density)
-    return PenetrationResult(curve, surface, bulk, bed.packing_fraction, bed.n_particles, inertial, wall, steps,
+    return PenetrationResult(curve, surface, highest - surface, bulk, bed.packing_fraction, bed.n_particles, inertial, wall, steps,
                              tool.scene.time_step, bed_seconds)
 
 
@@ -157,7 +161,7 @@ def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | No
                                    plate.sample_interval, progress, f"plate {1e3 * plate.diameter:g} mm")
     curve = LoadCurve("plate", plate.diameter, f"DEM, {1e3 * plate.diameter:g} mm plate, seed {bed_spec.seed}",
                       sinkage, force, area=plate_area(plate.diameter))
-    return _result(bed, curve, surface, plate.speed, plate.diameter, plate.area, tool, steps,
+    return _result(bed, curve, surface, highest, plate.speed, plate.diameter, plate.area, tool, steps,
                    time.perf_counter() - start, bed_seconds)
 
 
@@ -202,24 +206,27 @@ def wheel_press_test(bed_spec: BedSpec, press: WheelPressSpec, *, pair: PairProp
                                    progress, f"{press.wheel} wheel")
     curve = LoadCurve("wheel", wheel.radius, f"DEM, {press.wheel} wheel, seed {bed_spec.seed}", sinkage, force,
                       wheel=press.wheel)
-    return _result(bed, curve, surface, press.speed, wheel.width, 2 * chord * wheel.width, tool, steps,
+    return _result(bed, curve, surface, highest, press.speed, wheel.width, 2 * chord * wheel.width, tool, steps,
                    time.perf_counter() - start, bed_seconds)
 
 
 @dataclass(frozen=True)
 class RestingPlate:
     """A plate left to rest on the bed under gravity: its weight [N], the soil's mean vertical force on it over the
-    last half of the rest [N], and how far it sank [m]."""
+    last quarter of the rest [N], how far it sank [m] and its vertical speed at the end [m/s]."""
 
     weight: float
     soil_force: float
     settlement: float
+    final_speed: float
 
 
-def resting_plate(bed_spec: BedSpec, plate: PlateSpec, *, mass: float, rest_time: float = 0.1,
+def resting_plate(bed_spec: BedSpec, plate: PlateSpec, *, mass: float, rest_time: float = 0.25,
                   pair: PairProperties | None = None, cache_dir=None, arch: str | None = None) -> RestingPlate:
     """Lay a plate of ``mass`` [kg] on the bed, free to sink under gravity, and hold its weight against the soil's
-    force (the check that the soil carries what rests on it: equal to within the rest's remaining motion)."""
+    force (the check that the soil carries what rests on it: equal to within the rest's remaining motion). A plate
+    dropped on a loose bed of coarse spheres sinks a particle diameter or so and comes to rest within about 0.1 s.
+    """
     check_plate_fits("plate diameter", plate.diameter, bed_spec.length, bed_spec.width)
     check_resolution("plate diameter", plate.diameter, bed_spec.diameter_max)
     bed, _ = _bed(bed_spec, cache_dir, arch)
@@ -232,9 +239,9 @@ def resting_plate(bed_spec: BedSpec, plate: PlateSpec, *, mass: float, rest_time
     tool = RigidTool(scene, nodes + (center[0], center[1], z0), tri, plate.thickness, pair or bed_spec.wall_pair,
                      material=bed_spec.wall_material or STEEL, gravity=bed_spec.gravity, mass=mass)
     tool.move((0.0, 0.0, 0.0), free_z=True)
-    steps = int(math.ceil(0.5 * rest_time / scene.time_step))
-    scene.step(steps)
+    steps = int(math.ceil(0.25 * rest_time / scene.time_step))
+    scene.step(3 * steps)
     tool.soil_force()
     scene.step(steps)
     weight = tool.mass * bed_spec.gravity_magnitude
-    return RestingPlate(weight, float(tool.soil_force()[2]), z0 - float(tool.position[2]))
+    return RestingPlate(weight, float(tool.soil_force()[2]), z0 - float(tool.position[2]), float(tool.velocity[2]))

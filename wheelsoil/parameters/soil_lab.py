@@ -7,9 +7,10 @@ What is ours and why:
 * particles of 6.4--9.6 mm (mean 8 mm): the coarsest that put six across the 60 mm plate
   (``soillab.specs.MIN_PARTICLES_ACROSS``) -- sand grains are 0.1--1 mm, so the DEM's grains are a scaled-up sand
   whose scale error the convergence study states;
-* particle density 2300 kg/m^3: a poured bed of spheres packs to about 0.58, so 0.58 x 2300 = 1330 kg/m^3, the
-  sand's bulk density (quartz grains are 2650 kg/m^3 and pack looser than spheres; what matters to the stresses
-  under a plate is the bulk unit weight);
+* particle density 2340 kg/m^3: the lab's poured bed of these particles packs to 0.569 (three seeds at 2300 kg/m^3
+  gave 1309 +- 3 kg/m^3, ``wheelsoil soil-lab poured --density 2300``), so 0.569 x 2340 = 1330 kg/m^3, the sand's
+  bulk density (quartz grains are 2650 kg/m^3 and pack looser than spheres; what loads the soil under a plate is
+  the bulk unit weight);
 * Young's modulus 50 MPa, Poisson's ratio 0.3, restitution 0.5: seed 004's soil (Table 1); at the lab's largest
   stress (about 45 kPa under the 100 mm plate) the mean Hertz overlap stays below 5 % of a radius;
 * sliding friction 0.5, rolling friction 0.1: the starting point of the calibration, not a calibrated value;
@@ -27,7 +28,7 @@ from . import seed004
 CITATION = "wheelsoil's virtual soil lab defaults (ours, sized for the CMU sand's plate and wheel tests)"
 
 #: The particles a calibration starts from.
-PARTICLE_MATERIAL = Material("soil-lab start", youngs_modulus=50e6, poisson_ratio=0.3, density=2300.0)
+PARTICLE_MATERIAL = Material("soil-lab start", youngs_modulus=50e6, poisson_ratio=0.3, density=2340.0)
 PARTICLE_PAIR = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.1)
 #: The lab's walls, plates and boxes: steel against soil, seed 004's pair.
 TOOL_MATERIAL = seed004.BIN_WALLS
