@@ -20,6 +20,7 @@ from wheelsoil.gravity import GRAVITY_PRESETS
 from wheelsoil.parameters import smoke
 
 from . import soil_lab_command
+from .units import gravity_argument
 
 EXIT_OK, EXIT_BUG, EXIT_INPUT, EXIT_UNSTABLE, EXIT_SWEEP_FAILED = 0, 1, 2, 3, 4
 
@@ -66,20 +67,6 @@ or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 """
 
 
-def _gravity(value: str) -> float:
-    if value in GRAVITY_PRESETS:
-        return GRAVITY_PRESETS[value]
-    try:
-        g = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"gravity {value!r} is neither a preset {sorted(GRAVITY_PRESETS)} nor a number in m/s^2"
-        ) from None
-    if not (0 < g < 1000):
-        raise argparse.ArgumentTypeError(f"gravity {g} m/s^2 must lie in (0, 1000)")
-    return g
-
-
 #: prepare-bed's defaults without a CASE: the smoke run's bed (the parameter set every layer takes its defaults
 #: from), so that ``wheelsoil prepare-bed`` makes the bed ``wheelsoil run`` uses.
 BED_DEFAULTS = {"length": smoke.SOIL["length"], "width": smoke.SOIL["width"], "depth": smoke.SOIL["depth"],
@@ -97,7 +84,7 @@ def _add_bed_options(p: argparse.ArgumentParser) -> None:
                    help=f"smallest particle diameter [m] (default {d['dmin']}; seed 004: 0.016)")
     g.add_argument("--dmax", type=float, default=None,
                    help=f"largest particle diameter [m] (default {d['dmax']}; seed 004: 0.024)")
-    g.add_argument("--gravity", type=_gravity, default=None,
+    g.add_argument("--gravity", type=gravity_argument, default=None,
                    help=f"'earth' (9.81), 'moon' (9.81/6) or a value in m/s^2 (default {smoke.GRAVITY}); "
                         "beds are prepared under the gravity they are tested at")
     g.add_argument("--seed", type=int, default=None, help=f"random seed of radii and packing (default {d['seed']})")

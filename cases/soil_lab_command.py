@@ -17,20 +17,9 @@ from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import GRAVITY_PRESETS
 from wheelsoil.parameters import soil_lab
 
+from .units import gravity_argument
+
 TESTS = ("poured", "repose", "shear", "plate", "wheel")
-
-
-def _gravity(value: str) -> float:
-    if value in GRAVITY_PRESETS:
-        return GRAVITY_PRESETS[value]
-    try:
-        g = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"gravity {value!r} is neither a preset {sorted(GRAVITY_PRESETS)} nor a "
-                                         "number in m/s^2") from None
-    if not (0 < g < 1000):
-        raise argparse.ArgumentTypeError(f"gravity {g} m/s^2 must lie in (0, 1000)")
-    return g
 
 
 def add_parser(sub) -> None:
@@ -48,7 +37,7 @@ def add_parser(sub) -> None:
     g.add_argument("--friction", type=float, default=p.static_friction, help="particle sliding friction [-]")
     g.add_argument("--rolling-friction", type=float, default=p.rolling_friction, help="rolling friction [-]")
     g.add_argument("--restitution", type=float, default=p.restitution, help="restitution [-]")
-    g.add_argument("--gravity", type=_gravity, default=GRAVITY_PRESETS["earth"],
+    g.add_argument("--gravity", type=gravity_argument, default=GRAVITY_PRESETS["earth"],
                    help="'earth', 'moon' or m/s^2 (the sand's tests: earth)")
     g.add_argument("--seeds", type=int, nargs="+", default=None,
                    help="random packings (poured, repose: the spread; plate, wheel: replicas; shear: the first)")

@@ -62,3 +62,23 @@ def to_unit(value, unit: str):
     if factor < 1.0 and abs(inverse - round(inverse)) < 1e-9:
         return number / round(inverse)  # "37.5 mm" -> 0.0375 exactly as written in metres
     return number * factor
+
+
+def gravity_argument(value: str) -> float:
+    """A command line's gravity: a preset name of :data:`wheelsoil.gravity.GRAVITY_PRESETS` or a magnitude in
+    m/s^2 in (0, 1000) (an ``argparse`` type: bad values raise ``ArgumentTypeError`` naming them)."""
+    import argparse
+
+    from wheelsoil.gravity import GRAVITY_PRESETS
+
+    if value in GRAVITY_PRESETS:
+        return GRAVITY_PRESETS[value]
+    try:
+        g = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"gravity {value!r} is neither a preset {sorted(GRAVITY_PRESETS)} nor a number in m/s^2"
+        ) from None
+    if not (0 < g < 1000):
+        raise argparse.ArgumentTypeError(f"gravity {g} m/s^2 must lie in (0, 1000)")
+    return g

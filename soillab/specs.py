@@ -34,6 +34,12 @@ MIN_PARTICLES_ACROSS = 6.0
 MAX_OVERLAP_FRACTION = 0.05
 
 
+def _check_sampling(owner: str, interval: float, depth: float) -> None:
+    if interval > 0.25 * depth:
+        raise WheelsoilInputError(f"{owner} sample_interval = {interval!r} m must be at most a quarter of max_sinkage "
+                                  f"({0.25 * depth:g} m)")
+
+
 @dataclass(frozen=True)
 class PlateSpec:
     """A rigid circular plate pushed vertically into the bed at constant speed (SI units).
@@ -66,9 +72,7 @@ class PlateSpec:
         if self.thickness >= 0.5 * self.diameter:
             raise WheelsoilInputError(f"plate thickness = {self.thickness!r} m must be below half its diameter "
                                       f"({0.5 * self.diameter:g} m)")
-        if self.sample_interval > 0.25 * self.max_sinkage:
-            raise WheelsoilInputError(f"plate sample_interval = {self.sample_interval!r} m must be at most a quarter "
-                                      f"of max_sinkage ({0.25 * self.max_sinkage:g} m)")
+        _check_sampling("plate", self.sample_interval, self.max_sinkage)
 
     @property
     def area(self) -> float:
@@ -107,9 +111,7 @@ class WheelPressSpec:
         if self.wheel not in self.WHEELS:
             raise WheelsoilInputError(f"wheel press wheel = {self.wheel!r} is unknown; choose one of {list(self.WHEELS)}")
         check_ranges(self, self.RANGES, "wheel press", self.UNITS)
-        if self.sample_interval > 0.25 * self.max_sinkage:
-            raise WheelsoilInputError(f"wheel press sample_interval = {self.sample_interval!r} m must be at most a "
-                                      f"quarter of max_sinkage ({0.25 * self.max_sinkage:g} m)")
+        _check_sampling("wheel press", self.sample_interval, self.max_sinkage)
 
 
 @dataclass(frozen=True)
