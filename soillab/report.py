@@ -91,8 +91,9 @@ def write_shear(result: ShearResult, folder: Path) -> tuple[dict, dict[str, Path
                 for key, mc in (("peak", result.peak), ("residual", result.residual))}
     figures = {**envelope, "particles": result.particles, "bulk_density_kg_m3": result.bulk_density,
                "runs": [{"imposed_normal_Pa": r.normal_stress, "measured_normal_Pa": r.mean_normal,
-                         "peak_Pa": r.peak, "residual_Pa": r.residual, "wall_seconds": r.wall_seconds}
-                        for r in result.runs]}
+                         "shear_plane_normal_Pa": r.plane_normal, "peak_Pa": r.peak,
+                         "peak_displacement_m": r.peak_displacement, "peak_reached": r.peak_reached,
+                         "residual_Pa": r.residual, "wall_seconds": r.wall_seconds} for r in result.runs]}
     plt = _pyplot()
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 3.8))
     for r in result.runs:
@@ -100,14 +101,14 @@ def write_shear(result: ShearResult, folder: Path) -> tuple[dict, dict[str, Path
     a.set_xlabel("shear displacement [mm]")
     a.set_ylabel("shear stress [kPa]")
     a.legend()
-    sig = np.array([r.mean_normal for r in result.runs])
+    sig = np.array([r.plane_normal for r in result.runs])
     grid = np.linspace(0, sig.max() * 1.1, 20)
     for key, mc, marker in (("peak", result.peak, "o"), ("residual", result.residual, "s")):
         values = [r.peak if key == "peak" else r.residual for r in result.runs]
         b.plot(1e-3 * sig, 1e-3 * np.asarray(values), marker, label=f"{key}: φ = {mc.friction_angle:.1f} ± "
                f"{mc.friction_angle_se:.1f}°, c = {1e-3 * mc.cohesion:.2f} ± {1e-3 * mc.cohesion_se:.2f} kPa")
         b.plot(1e-3 * grid, 1e-3 * (mc.cohesion + grid * math.tan(math.radians(mc.friction_angle))), "--", lw=0.8)
-    b.set_xlabel("normal stress [kPa]")
+    b.set_xlabel("normal stress on the shear plane [kPa]")
     b.set_ylabel("shear stress [kPa]")
     b.legend(fontsize=8)
     return figures, _write(folder, "shear", pd.concat(rows), figures, fig)

@@ -8,10 +8,12 @@ moves along +x at constant speed, and a loading cap free to rise or sink under t
 
 Measured per sample (each the mean over the DEM steps of one ``sample_interval`` of displacement): the shear force,
 minus the soil's force along x on the ring and the cap; the normal force, the soil's force on the cap; the cap's
-height (dilatancy). Stresses are these forces over the nominal area A = side^2. The peak is the largest shear stress
-of a 5-sample running mean, the residual the mean over the last fifth of the travel. Mohr--Coulomb
-tau = c + sigma tan(phi) is fitted by least squares over the normal stresses (scipy.stats.linregress), giving phi
-and c with their standard errors.
+height (dilatancy). Stresses are these forces over the nominal area A = side^2. The normal stress on the shear plane
+is the cap's plus the weight of the spheres above the plane (measured after consolidation) over A; the envelope is
+fitted against it. The peak is the largest shear stress of a 5-sample running mean (with the displacement it was
+reached at: a loose packing may still harden at the end of the travel, and then the peak is no peak), the residual
+the mean over the last fifth of the travel. Mohr--Coulomb tau = c + sigma tan(phi) is fitted by least squares over
+the normal stresses (scipy.stats.linregress), giving phi and c with their standard errors.
 """
 
 from __future__ import annotations
@@ -41,8 +43,9 @@ FLANGE = 0.3
 
 @dataclass(frozen=True)
 class ShearRun:
-    """One normal stress: imposed sigma [Pa]; per sample the displacement [m], shear and normal stress [Pa] and the
-    cap's rise [m]; peak and residual shear stress [Pa] and the mean measured normal stress while shearing [Pa]."""
+    """One normal stress: imposed sigma [Pa]; per sample the displacement [m], shear and cap normal stress [Pa] and
+    the cap's rise [m]; peak and residual shear stress [Pa], the displacement at the peak [m], the mean normal stress
+    the cap measured while shearing [Pa] and the normal stress on the shear plane (cap and the soil above) [Pa]."""
 
     normal_stress: float
     displacement: np.ndarray
@@ -53,6 +56,13 @@ class ShearRun:
     residual: float
     mean_normal: float
     wall_seconds: float
+    peak_displacement: float = float("nan")
+    plane_normal: float = float("nan")
+
+    @property
+    def peak_reached(self) -> bool:
+        """The peak came before the last fifth of the travel (else the sample was still hardening)."""
+        return bool(self.peak_displacement < 0.8 * self.displacement[-1])
 
 
 @dataclass(frozen=True)
@@ -117,6 +127,8 @@ def _one_stress(bed: Bed, spec: ShearSpec, sigma: float, arch) -> ShearRun:
     dt = scene.time_step
     scene.step(int(math.ceil(spec.consolidation_time / dt)))
     z0 = float(cap.position[2])
+    above = scene.positions[:, 2] > half
+    plane_extra = float(scene.masses[above].sum()) * s.gravity_magnitude / spec.area
     steps = max(1, int(round(spec.sample_interval / spec.speed / dt)))
     velocity = (spec.speed, 0.0, 0.0)
     ring.move(velocity)
@@ -135,8 +147,10 @@ def _one_stress(bed: Bed, spec: ShearSpec, sigma: float, arch) -> ShearRun:
     disp, tau, normal, rise = (np.asarray(a) for a in (disp, tau, normal, rise))
     smooth = np.convolve(tau, np.ones(5) / 5, mode="valid")
     tail = disp >= 0.8 * disp[-1]
+    at_peak = int(np.argmax(smooth)) + 2
     return ShearRun(sigma, disp, tau, normal, rise, float(smooth.max()), float(tau[tail].mean()),
-                    float(normal.mean()), time.perf_counter() - start)
+                    float(normal.mean()), time.perf_counter() - start, float(disp[at_peak]),
+                    float(normal.mean()) + plane_extra)
 
 
 def shear_test(bed_spec: BedSpec, spec: ShearSpec, *, cache_dir=None, arch: str | None = None,
@@ -175,7 +189,7 @@ def shear_test(bed_spec: BedSpec, spec: ShearSpec, *, cache_dir=None, arch: str 
     finally:
         if bar is not None:
             bar.stop()
-    normal = [r.mean_normal for r in runs]
+    normal = [r.plane_normal for r in runs]
     return ShearResult(tuple(runs), mohr_coulomb(normal, [r.peak for r in runs]),
                        mohr_coulomb(normal, [r.residual for r in runs]), bed.n_particles,
                        bed.packing_fraction * spec_bed.material.density)

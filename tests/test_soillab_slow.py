@@ -42,7 +42,7 @@ def test_angle_of_repose_over_packings(bed_cache):
 
 @pytest.mark.parametrize("wheel", ["smooth", "grouser"])
 def test_cmu_wheel_pressed_into_a_bed(bed_cache, wheel):
-    bed = small_bed(length=0.3, width=0.16, depth=0.05, diameter_min=0.006, diameter_max=0.008)
+    bed = small_bed(length=0.4, width=0.16, depth=0.05, diameter_min=0.006, diameter_max=0.008)
     result = wheel_press_test(bed, WheelPressSpec(wheel=wheel, speed=0.1, max_sinkage=0.01, sample_interval=0.001),
                               cache_dir=bed_cache)
     c = result.curve

@@ -39,8 +39,9 @@ DIAMETER_MIN, DIAMETER_MAX = 0.0064, 0.0096
 PLATE_BOX = dict(length=0.3, width=0.3, depth=0.12)
 PLATE_DIAMETERS = (0.06, 0.1)
 PRESS = dict(speed=0.03, max_sinkage=0.03, sample_interval=0.0005)
-#: The wheel-sinkage box (the K10-mini wheel: r = 0.058 m, b = 0.05 m).
-WHEEL_BOX = dict(length=0.36, width=0.2, depth=0.12)
+#: The wheel-sinkage box (the K10-mini wheel: r = 0.058 m, b = 0.05 m, 0.126 m across its grousers; the walls one
+#: diameter away along the travel and one width across it).
+WHEEL_BOX = dict(length=0.4, width=0.2, depth=0.12)
 #: Direct shear box and normal stresses [Pa].
 SHEAR = dict(side=0.12, height=0.06, normal_stresses=(5e3, 10e3, 20e3), speed=0.02, max_displacement=0.015,
              sample_interval=0.0003, consolidation_time=0.15)
