@@ -60,7 +60,7 @@ SHEAR_BED = dict(diameter_min=0.005, diameter_max=0.0065)
 
 def test_shear_box_holds_the_imposed_normal_stress(bed_cache):
     """The cap, free under sigma A, carries the imposed stress while the ring moves (to 1 % over the samples)."""
-    spec = ShearSpec(normal_stresses=(4e3, 8e3, 12e3), side=0.08, height=0.04, speed=0.1, max_displacement=0.0016,
+    spec = ShearSpec(normal_stresses=(4e3, 8e3, 12e3), side=0.08, height=0.04, speed=0.1, max_displacement=0.002,
                      sample_interval=0.0002, consolidation_time=0.02)
     result = shear_test(small_bed(), spec, cache_dir=bed_cache)
     for run in result.runs:
