@@ -66,15 +66,13 @@ def footprint_surface(bed: Bed, center_xy, half_x: float, half_y: float) -> tupl
         raise WheelsoilInputError("no sphere lies under the tool's footprint: the bed is empty there")
     top = x[inside, 2] + r[inside]
     cols = np.floor((x[inside, :2] - lo) / d).astype(np.int64)
-    key = cols[:, 0] * 100_000 + cols[:, 1]
-    highest = {}
-    for k, h in zip(key.tolist(), top.tolist()):
-        if h > highest.get(k, -math.inf):
-            highest[k] = h
-    return float(np.mean(list(highest.values()))), float(top.max())
+    _, column = np.unique(cols, axis=0, return_inverse=True)
+    highest = np.full(int(column.max()) + 1, -math.inf)
+    np.maximum.at(highest, column.ravel(), top)
+    return float(highest.mean()), float(top.max())
 
 
-def _press(bed: Bed, tool: RigidTool, bottom_offset: float, surface: float, speed: float, max_sinkage: float,
+def _press(tool: RigidTool, bottom_offset: float, surface: float, speed: float, max_sinkage: float,
            sample_interval: float, progress: bool, label: str) -> tuple[np.ndarray, np.ndarray, int]:
     """Move ``tool`` down at ``speed`` until its lowest point is ``max_sinkage`` below ``surface``; returns the
     sinkage [m] and the soil's vertical force [N] of every sample and the steps taken."""
@@ -157,7 +155,7 @@ def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | No
     scene = bed.to_scene(headroom=max(plate.max_sinkage, 0.05), arch=arch)
     tool = RigidTool(scene, nodes + (center[0], center[1], z0), tri, plate.thickness,
                      pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL)
-    sinkage, force, steps = _press(bed, tool, -0.5 * plate.thickness, surface, plate.speed, plate.max_sinkage,
+    sinkage, force, steps = _press(tool, -0.5 * plate.thickness, surface, plate.speed, plate.max_sinkage,
                                    plate.sample_interval, progress, f"plate {1e3 * plate.diameter:g} mm")
     curve = LoadCurve("plate", plate.diameter, f"DEM, {1e3 * plate.diameter:g} mm plate, seed {bed_spec.seed}",
                       sinkage, force, area=plate_area(plate.diameter))
@@ -202,7 +200,7 @@ def wheel_press_test(bed_spec: BedSpec, press: WheelPressSpec, *, pair: PairProp
     tool = RigidTool(scene, mesh.nodes[used] + (center[0], center[1], z0), renumber[tri], thickness,
                      pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL,
                      center=(center[0], center[1], z0))
-    sinkage, force, steps = _press(bed, tool, lowest, surface, press.speed, press.max_sinkage, press.sample_interval,
+    sinkage, force, steps = _press(tool, lowest, surface, press.speed, press.max_sinkage, press.sample_interval,
                                    progress, f"{press.wheel} wheel")
     curve = LoadCurve("wheel", wheel.radius, f"DEM, {press.wheel} wheel, seed {bed_spec.seed}", sinkage, force,
                       wheel=press.wheel)
