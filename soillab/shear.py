@@ -12,7 +12,7 @@ height (dilatancy). Stresses are these forces over the nominal area A = side^2. 
 is the cap's plus the weight of the spheres above the plane (measured after consolidation) over A; the envelope is
 fitted against it. The peak is the largest shear stress of a 5-sample running mean (with the displacement it was
 reached at: a loose packing may still harden at the end of the travel, and then the peak is no peak), the residual
-the mean over the last fifth of the travel. Mohr--Coulomb tau = c + sigma tan(phi) is fitted by least squares over
+the mean of the same running mean over the last fifth of the travel (so never above the peak). Mohr--Coulomb tau = c + sigma tan(phi) is fitted by least squares over
 the normal stresses (scipy.stats.linregress), giving phi and c with their standard errors.
 """
 
@@ -145,10 +145,10 @@ def _one_stress(bed: Bed, spec: ShearSpec, sigma: float, arch) -> ShearRun:
         normal.append(f_cap[2] / spec.area)
         rise.append(float(cap.position[2]) - z0)
     disp, tau, normal, rise = (np.asarray(a) for a in (disp, tau, normal, rise))
-    smooth = np.convolve(tau, np.ones(5) / 5, mode="valid")
-    tail = disp >= 0.8 * disp[-1]
+    smooth = np.convolve(tau, np.ones(5) / 5, mode="valid")  # centred on disp[2:-2]
+    tail = max(1, round(len(tau) / 5))  # the running means of the last fifth of the travel
     at_peak = int(np.argmax(smooth)) + 2
-    return ShearRun(sigma, disp, tau, normal, rise, float(smooth.max()), float(tau[tail].mean()),
+    return ShearRun(sigma, disp, tau, normal, rise, float(smooth.max()), float(smooth[-tail:].mean()),
                     float(normal.mean()), time.perf_counter() - start, float(disp[at_peak]),
                     float(normal.mean()) + plane_extra)
 
