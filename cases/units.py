@@ -13,8 +13,11 @@ A unit of the wrong dimension ("3 kN" for a time) is an error that names the uni
 
 from __future__ import annotations
 
+import argparse
 import math
 import re
+
+from wheelsoil.gravity import GRAVITY_PRESETS
 
 #: For each canonical unit of a case key, the units it may be written in and their factor to it.
 UNITS: dict[str, dict[str, float]] = {
@@ -67,10 +70,6 @@ def to_unit(value, unit: str):
 def gravity_argument(value: str) -> float:
     """A command line's gravity: a preset name of :data:`wheelsoil.gravity.GRAVITY_PRESETS` or a magnitude in
     m/s^2 in (0, 1000) (an ``argparse`` type: bad values raise ``ArgumentTypeError`` naming them)."""
-    import argparse
-
-    from wheelsoil.gravity import GRAVITY_PRESETS
-
     if value in GRAVITY_PRESETS:
         return GRAVITY_PRESETS[value]
     try:

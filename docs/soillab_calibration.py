@@ -4,7 +4,7 @@ against the sand's own measurements written as it finishes, so an interrupted ca
 
 Usage (from the repository root, ``../shared`` beside it; about 15 min a candidate on 2 cores)::
 
-    python docs/soillab_calibration.py run --out docs/soillab/calibration [--resume] [--cache DIR]
+    python docs/soillab_calibration.py run --out docs/soillab/calibration [--resume] [--cache DIR] [--max-candidates N]
     python docs/soillab_calibration.py summary docs/soillab/calibration
 
 What each candidate does, chosen before any result was seen:
@@ -90,12 +90,17 @@ def candidate(mu: float, mu_r: float, cache) -> dict:
 def run(args) -> int:
     out = Path(args.out)
     (out / "candidates").mkdir(parents=True, exist_ok=True)
+    ran = 0
     for mu in FRICTIONS:
         for mu_r in ROLLING:
             path = out / "candidates" / f"mu{mu:g}_mur{mu_r:g}.json"
             if args.resume and path.is_file():
                 print(f"{path.name}: done before, kept", flush=True)
                 continue
+            if args.max_candidates is not None and ran >= args.max_candidates:
+                print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
+                return summary(args)
+            ran += 1
             row = candidate(mu, mu_r, args.cache)
             tmp = path.with_suffix(".partial")
             tmp.write_text(json.dumps(row, indent=1))
@@ -140,6 +145,7 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="docs/soillab/calibration")
     p.add_argument("--resume", action="store_true")
     p.add_argument("--cache", default=None)
+    p.add_argument("--max-candidates", type=int, default=None, help="run at most this many (a session's share)")
     p.set_defaults(func=run)
     p = sub.add_parser("summary")
     p.add_argument("out", nargs="?", default="docs/soillab/calibration")

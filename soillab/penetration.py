@@ -36,7 +36,7 @@ class PenetrationResult:
     curve: force against sinkage (:class:`~.measured.LoadCurve`); surface: the zero of sinkage [m]; top_offset: how
     far the highest sphere top under the footprint stands above it [m] (the tool touches the first sphere at
     sinkage -top_offset; on coarse spheres about a diameter);
-    bulk_density: the bed's [kg/m^3]; packing_fraction; particles; inertial_number at the deepest sample (the
+    bulk_density: the bed's [kg/m^3]; packing_fraction; gravity: its magnitude [m/s^2]; particles; inertial_number at the deepest sample (the
     flow is quasi-static below about 1e-3); wall_seconds; steps; time_step [s]; bed_seconds: preparing the bed
     (0 when it came from the cache).
     """
@@ -51,6 +51,7 @@ class PenetrationResult:
     wall_seconds: float
     steps: int
     time_step: float
+    gravity: float
     bed_seconds: float = 0.0
     meta: dict = field(default_factory=dict)
 
@@ -135,7 +136,7 @@ def _result(bed: Bed, curve: LoadCurve, surface: float, highest: float, speed: f
     rate = speed / footprint
     inertial = inertial_number(rate, d_mean, max(deepest, bulk * s.gravity_magnitude * d_mean), s.material.density)
     return PenetrationResult(curve, surface, highest - surface, bulk, bed.packing_fraction, bed.n_particles, inertial, wall, steps,
-                             tool.scene.time_step, bed_seconds)
+                             tool.scene.time_step, s.gravity_magnitude, bed_seconds)
 
 
 def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | None = None, cache_dir=None,

@@ -205,7 +205,7 @@ def write_penetration(results: list[PenetrationResult], measured: list[LoadCurve
 def _bearing(result: PenetrationResult, friction_angle: float, cohesion: float) -> dict:
     c = result.curve
     depth = float(c.sinkage.max())
-    unit_weight = result.bulk_density * 9.81
+    unit_weight = result.bulk_density * result.gravity
     cap = circular_footing(c.size, depth, friction_angle, cohesion, unit_weight)
     deepest = float(np.mean(c.force[-5:])) / c.area
     return {"label": c.label, "depth_m": depth, "pressure_at_depth_Pa": deepest, "meyerhof_Pa": cap.meyerhof,

@@ -18,8 +18,8 @@ GROUSER_COUNT, GROUSER_THICKNESS = 16, 0.0025
 #: contact surface lies; the outer radius stays RADIUS).
 TREAD_THICKNESS = 0.002
 
-#: The two K10-mini wheels as keyword arguments of ``wheelsoil.flexwheel.geometry.WheelGeometry`` (spokes, hub and
-#: element size are placeholders of the mesh: the CMU wheels are run rigid).
+#: The two K10-mini wheels as keyword arguments of ``wheelsoil.flexwheel.geometry.WheelGeometry`` (ours: the spokes
+#: and hub only shape the mesh inside the rim, since the CMU wheels are run rigid; element size 6 mm).
 K10_MINI_WHEEL = dict(
     radius=RADIUS, width=WIDTH, tread_thickness=TREAD_THICKNESS, hub_radius=0.02, spokes_per_row=6,
     spoke_thickness=0.003, spoke_rows=((-0.5, 0.5, 0.0),), spoke_bow=0.0, element_size=0.006,
