@@ -59,6 +59,11 @@ fit on one dataset, predict another, or hold each steering angle out in turn:
     wheelsoil predict runs/s2g/model.json grouser_wheel_trials.csv --out runs/s2g-predict
     wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --cv slip_angle --report runs/cv
 
+run the virtual soil lab on the particles, with the CMU sand's measurements beside (poured, repose, shear,
+plate, wheel):
+
+    wheelsoil soil-lab plate --seeds 0 1 2
+
 or prepare your own beds, e.g. a Moon-gravity bed of seed-004 particles:
 
     wheelsoil prepare-bed --length 1.0 --width 0.5 --depth 0.15 --dmin 0.016 --dmax 0.024 --gravity moon \
