@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.granular.bed import BedSpec, prepare_bed
+
+from .specs import check_seeds
 
 
 @dataclass(frozen=True)
@@ -54,9 +55,7 @@ class PouredBedResult:
 def poured_bed_test(bed_spec: BedSpec, seeds=(0, 1, 2), *, cache_dir=None, arch: str | None = None,
                     progress: bool = False) -> PouredBedResult:
     """Prepare the bed of ``bed_spec`` once per seed and measure each."""
-    seeds = tuple(int(s) for s in seeds)
-    if not seeds or len(set(seeds)) != len(seeds) or min(seeds) < 0:
-        raise WheelsoilInputError(f"poured bed seeds = {list(seeds)}: give one or more distinct seeds >= 0")
+    seeds = check_seeds("poured bed", seeds)
     beds = []
     for seed in seeds:
         spec = dataclasses.replace(bed_spec, seed=seed)

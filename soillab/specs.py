@@ -34,6 +34,14 @@ MIN_PARTICLES_ACROSS = 6.0
 MAX_OVERLAP_FRACTION = 0.05
 
 
+def check_seeds(owner: str, seeds) -> tuple[int, ...]:
+    """The seeds as a tuple of ints; refused unless one or more, distinct and >= 0."""
+    values = tuple(int(s) for s in seeds)
+    if not values or len(set(values)) != len(values) or min(values) < 0:
+        raise WheelsoilInputError(f"{owner} seeds = {list(seeds)}: give one or more distinct seeds >= 0")
+    return values
+
+
 def _check_sampling(owner: str, interval: float, depth: float) -> None:
     if interval > 0.25 * depth:
         raise WheelsoilInputError(f"{owner} sample_interval = {interval!r} m must be at most a quarter of max_sinkage "
@@ -189,10 +197,7 @@ class ReposeSpec:
 
     def __post_init__(self) -> None:
         check_ranges(self, self.RANGES, "repose box", self.UNITS)
-        seeds = tuple(int(s) for s in self.seeds)
-        if not seeds or len(set(seeds)) != len(seeds) or min(seeds) < 0:
-            raise WheelsoilInputError(f"repose seeds = {list(self.seeds)}: give one or more distinct seeds >= 0")
-        object.__setattr__(self, "seeds", seeds)
+        object.__setattr__(self, "seeds", check_seeds("repose", self.seeds))
         if self.height > self.length:
             raise WheelsoilInputError(f"repose box height = {self.height!r} m exceeds its length {self.length!r} m: "
                                       "a slope at the angle of repose would reach the back wall")
