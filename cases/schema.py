@@ -199,12 +199,14 @@ class Contact(_Section):
 class Test(_Section):
     __test__ = False  # not a pytest class
 
-    slip: float = _q(smoke.TEST["slip"], "1", "longitudinal slip i = 1 - v_x / (r omega) (negative: braking)",
+    slip: float = _q(smoke.TEST["slip"], "1", "longitudinal slip: driving i = 1 - v_x / (r omega); braking (< 0) "
+                     "i = r omega / v_x - 1, -1 a wheel dragged without turning",
                      _TEST["slip"])
     slip_angle: float = _q(smoke.TEST["slip_angle"], "deg", "steering (slip) angle beta between heading and travel",
                            _TEST["slip_angle"])
     load: float = _q(smoke.TEST["load"], "N", "vertical load W on the soil, wheel weight included", _TEST["load"])
-    angular_velocity: float = _q(smoke.TEST["angular_velocity"], "rad/s", "wheel spin omega",
+    angular_velocity: float = _q(smoke.TEST["angular_velocity"], "rad/s", "reference spin omega_0: the hub's spin when "
+                                 "driving; braking, the carriage travels at r omega_0 and the hub spins at (1 + i) omega_0",
                                  _TEST["angular_velocity"])
     lowering_speed: float = _q(smoke.TEST["lowering_speed"], "m/s", "speed at which the rig lowers the wheel until "
                                "the soil carries W", _TEST["lowering_speed"])

@@ -13,9 +13,9 @@ is the **tread slip**, from the tread's own rotation (architecture conventions),
 
 Frames and signs (architecture): wheel frame x along the heading, y along the axle, z up; the hub spins
 at +omega about the axle. ``wind_up`` > 0 means the tread lags the hub (a driving torque); the tread
-slip is i_t = 1 - v_x / (r omega_t) with omega_t the tread's spin and v_x the hub's travel velocity along
-the tread's heading, and the tread slip angle is the angle between the tread's heading and the hub's
-travel direction.
+slip i_t is :func:`longitudinal_slip` (i = 1 - v_x / (r omega) driving, r omega / v_x - 1 braking) with the
+tread's spin omega_t and the hub's travel velocity v_x along the tread's heading, and the tread slip angle
+is the angle between the tread's heading and the hub's travel direction.
 """
 
 from __future__ import annotations
@@ -78,13 +78,33 @@ class TreadTracker:
         )
 
 
-def tread_slip(travel_speed_along_heading, tread_spin, radius: float):
-    """i_t = 1 - v_x / (r omega_t) (seed 004 eq. 14 with the tread's own spin); 0 where omega_t = 0."""
+def longitudinal_slip(travel_speed_along_heading, spin, radius: float):
+    """Longitudinal slip by the measured rigs' convention (architecture): driving (r omega >= v_x),
+    i = 1 - v_x / (r omega) (seed 004 eq. 14); braking (r omega < v_x), i = r omega / v_x - 1, so a wheel dragged
+    without turning has i = -1 and a free-rolling one 0 on both branches (the CMU rig's definitions,
+    ``../shared/data/measured/cmu_3d_terramechanics/README.md``). 0 where neither the wheel travels nor turns.
+
+    travel_speed_along_heading: v_x [m/s]; spin: omega [rad/s] (the hub's, or the tread's own for the tread
+    slip); radius: r [m]. Scalars or arrays (broadcast)."""
     v = np.asarray(travel_speed_along_heading, float)
-    w = np.asarray(tread_spin, float)
+    rim = radius * np.asarray(spin, float)
+    v, rim = np.broadcast_arrays(v, rim)
     with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.where(w != 0.0, 1.0 - v / (radius * np.where(w != 0.0, w, 1.0)), 0.0)
+        driving = np.where(rim > 0.0, 1.0 - v / np.where(rim > 0.0, rim, 1.0), 0.0)
+        braking = np.where(v > 0.0, rim / np.where(v > 0.0, v, 1.0) - 1.0, 0.0)
+    out = np.where(rim >= v, driving, braking)
     return out if out.ndim else float(out)
+
+
+def rig_command(slip: float, reference_spin: float, radius: float) -> tuple[float, float]:
+    """The hub spin omega [rad/s] and the travel speed along the heading v_x [m/s] that give the commanded
+    ``slip`` (:func:`longitudinal_slip`'s convention) with the reference spin omega_0 = ``reference_spin``:
+    driving (i >= 0) the hub spins at omega_0 and travels at v_x = (1 - i) r omega_0; braking (i < 0) it
+    travels at the free-rolling speed v_x = r omega_0 and spins at omega = (1 + i) omega_0 (0: dragged).
+    Both branches meet at i = 0, so a slip sweep through zero is continuous."""
+    if slip >= 0.0:
+        return reference_spin, (1.0 - slip) * radius * reference_spin
+    return (1.0 + slip) * reference_spin, radius * reference_spin
 
 
 def slip_angle_deg(velocity, heading, axle) -> float:

@@ -58,8 +58,9 @@ That window is **steady** when every quantity passes one of two tests, and the t
   What can be asked of it is that it does not trend, and that is what this test asks; its mean is then reported
   with its standard error, not as a value.
 
-The tread is where the rig wants it when the tread slip over the window -- from the tread's mean spin,
-1 - v_x / (r pitch-angle / pitch-time) -- lies within ``slip_tolerance`` of the commanded slip and does not
+The tread is where the rig wants it when the tread slip over the window -- from the tread's mean spin
+omega_t = pitch-angle / pitch-time, :func:`.kinematics.longitudinal_slip` (1 - v_x / (r omega_t) driving,
+r omega_t / v_x - 1 braking) -- lies within ``slip_tolerance`` of the commanded slip and does not
 itself drift by more than ``slip_tolerance`` (the tread turns at the hub's rate: the wind-up has settled).
 If it is not steady, :func:`detect_steady_state` says which quantity failed and by how much.
 
@@ -77,6 +78,8 @@ from functools import lru_cache
 
 import numpy as np
 from scipy.stats import t as student_t
+
+from .kinematics import longitudinal_slip
 
 
 @dataclass
@@ -238,6 +241,7 @@ def detect_steady_state(
     *,
     tread_angle: np.ndarray,
     travel_speed: np.ndarray,
+    batch_angle: np.ndarray | None = None,
     radius: float,
     pitch: float,
     start: float,
@@ -256,6 +260,8 @@ def detect_steady_state(
     t: sample times [s] (end of each sample's interval); series: name -> per-sample values;
     tread_angle: the tread's rotation angle about its axle [rad] at each sample time (unwrapped,
     increasing while driving); travel_speed: the hub's travel velocity along the tread heading [m/s];
+    batch_angle: the increasing angle [rad] whose pitches are the statistics' batches (default: the tread
+    angle; a wheel dragged without turning gives its travel over r);
     radius: wheel radius for the slip [m]; pitch: grouser (or spoke) pitch [rad], the batch of the
     statistics; period_pitches: windows span a multiple of this many pitches (the wheel's whole period
     when spokes and grousers repeat at different pitches); start: earliest window start [s];
@@ -268,6 +274,7 @@ def detect_steady_state(
     t = np.asarray(t, float)
     n = len(t)
     angle = np.asarray(tread_angle, float)
+    batch = angle if batch_angle is None else np.asarray(batch_angle, float)
     v = np.asarray(travel_speed, float)
     k_min = int(np.searchsorted(t - sample_interval, start - 1e-12))
     period_pitches = max(1, int(period_pitches))
@@ -276,9 +283,9 @@ def detect_steady_state(
     short = SteadyState(False, n, n, ((float(t[-1]) if n else 0.0),) * 2, 0,
                         reasons=[f"the tread has not yet turned through {min_pitches} pitches "
                                  f"({math.degrees(min_pitches * pitch):.0f} deg) since t = {start:.3f} s"])
-    if n < 2 or k_min >= n - 1 or not np.all(np.isfinite(angle[k_min:])):
+    if n < 2 or k_min >= n - 1 or not np.all(np.isfinite(batch[k_min:])):
         return short
-    bounds = pitch_boundaries(angle, n, pitch, max(k_min, 1))
+    bounds = pitch_boundaries(batch, n, pitch, max(k_min, 1))
     if len(bounds) - 1 < min_pitches:
         return short
     n_pitches = (len(bounds) - 1)
@@ -286,7 +293,7 @@ def detect_steady_state(
     durations = np.array([t[e - 1] - t[s - 1] for s, e in pairs_all])
     turned = np.array([angle[e - 1] - angle[s - 1] for s, e in pairs_all])
     speeds = np.array([v[s:e].mean() for s, e in pairs_all])
-    per_pitch_slip = 1.0 - speeds / (radius * turned / durations)
+    per_pitch_slip = longitudinal_slip(speeds, turned / durations, radius)
     batches = {name: np.array([np.asarray(y, float)[s:e].mean() for s, e in pairs_all]) for name, y in series.items()}
     if slip_target is not None:
         batches["tread_slip"] = per_pitch_slip
@@ -326,7 +333,7 @@ def detect_steady_state(
             reasons.append(f"{name} changes by {st['step']:+.4g} between the window's halves (allowed +-{allowed:.3g})")
     w = slice(n_pitches - m, n_pitches)
     spin = turned[w].sum() / durations[w].sum()
-    slip = 1.0 - float(speeds[w] @ durations[w] / durations[w].sum()) / (radius * spin) if spin > 0 else math.nan
+    slip = longitudinal_slip(float(speeds[w] @ durations[w] / durations[w].sum()), spin, radius)
     slip_noise = noise.get("tread_slip", pitch_noise(per_pitch_slip[w], period_pitches))
     slip_sem = slip_noise / math.sqrt(m)
     slip_drift = periodic_trend(per_pitch_slip[w], period_pitches)[0] * (m - 1)

@@ -4,9 +4,13 @@ Rig kinematics (architecture conventions; seed 004 eqs. 14--16):
 
 * wheel frame: x along the heading, y along the axle, z up; the carriage travels along the bin's +X;
   the wheel is yawed by -beta so that the steering (slip) angle beta lies between heading and travel;
-* the hub spins at omega about the axle; the carriage travels at v_x = (1 - i) r omega along the heading
-  and v_y = v_x tan(beta) across it (global speed v_x / cos beta): i and beta are the *commanded* slip and
-  slip angle, those of the hub;
+* slip by the measured rigs' convention (architecture; :func:`.kinematics.longitudinal_slip`): driving,
+  i = 1 - v_x / (r omega); braking, i = r omega / v_x - 1, so -1 is a wheel dragged without turning. With
+  the rig's reference spin omega_0 (``angular_velocity``) the hub spins at omega_0 and the carriage travels
+  at v_x = (1 - i) r omega_0 along the heading when driving; when braking the carriage travels at the
+  free-rolling v_x = r omega_0 and the hub spins at (1 + i) omega_0 (:func:`.kinematics.rig_command`);
+  v_y = v_x tan(beta) across the heading (global speed v_x / cos beta): i and beta are the *commanded* slip
+  and slip angle, those of the hub;
 * the axle is free vertically under the constant load W: the rig applies W - m g downwards at the hub
   so the total load on the soil is W at any gravity (m: wheel mass including the hub), and a viscous
   damper on the vertical slide (``axle_damping``) keeps the wheel's heave from ringing.
@@ -67,7 +71,7 @@ from wheelsoil.parameters import smoke
 from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
 from .contact import WheelContact
-from .kinematics import TreadTracker, deformation, slip_angle_deg
+from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg
 from .patch import MovingPatch, PatchGeometry
 from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
 
@@ -86,6 +90,7 @@ SERIES_UNITS = {
     "tread_slip_angle": "deg",
     "wind_up": "rad",
     "tread_omega": "rad/s",
+    "heading_speed": "m/s",
     "load": "N",
     "omega": "rad/s",
     "travel": "m",
@@ -110,10 +115,12 @@ def _check(key: str, value, ok: bool, allowed: str) -> None:
 class TestbedSpec:
     """What the rig does (SI units, angles in degrees).
 
-    slip: commanded longitudinal slip i = 1 - v_x / (r omega), in [-1, 1) (negative: braking).
+    slip: commanded longitudinal slip in [-1, 1): driving (>= 0) i = 1 - v_x / (r omega); braking (< 0)
+        i = r omega / v_x - 1, -1 a wheel dragged without turning (the measured rigs' convention).
     slip_angle: steering angle beta between heading and travel [deg], in (-90, 90).
     load: vertical load W on the soil, wheel weight included [N], > 0.
-    angular_velocity: wheel spin omega [rad/s], > 0 (seed 004: r omega = 0.6 m/s).
+    angular_velocity: the rig's reference spin omega_0 [rad/s], > 0 (seed 004: r omega = 0.6 m/s): the hub's
+        spin when driving; when braking the carriage travels at r omega_0 and the hub spins at (1 + i) omega_0.
     lowering_speed: speed [m/s] at which the rig lowers the wheel onto the soil until the soil carries W.
     settle_time: time the wheel then rests, free vertically under W, before driving [s].
     spin_up_time: time over which omega (and the carriage speed) rise linearly [s].
@@ -338,7 +345,7 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     if bed.periodic:
         shift = spec.patch_shift or 0.2 * wheel.radius
         return PatchGeometry.for_wheel(bed.length, outer, shift, bed.diameter_max).check(spec.start_x)
-    speed = (1.0 - spec.slip) * wheel.radius * spec.angular_velocity / math.cos(beta)
+    speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)[1] / math.cos(beta)
     travel = abs(speed) * (spec.drive_time + spec.spin_up_time)
     start_x = spec.start_x if spec.start_x is not None else outer + 0.1
     if start_x - outer < 0 or start_x + travel + outer > bed.length:
@@ -382,7 +389,12 @@ class Testbed:
         outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
         self.outer_radius = outer
         self.gravity = -float(bs.gravity[2])
-        self.travel_speed = (1.0 - spec.slip) * wheel.radius * spec.angular_velocity / math.cos(beta)  # along the bin
+        # the hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] (kinematics.rig_command)
+        self.spin_command, heading_speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)
+        self.travel_speed = heading_speed / math.cos(beta)
+        #: the rate [rad/s] at which the statistics' batches pass: the hub's spin, or for a dragged wheel (no
+        #: spin) the angle it would roll through at its travel speed
+        self.batch_rate = batch_rate(spec.slip, spec.angular_velocity, wheel.radius)
         self.periodic = bool(bs.periodic)
         start_x = check_fits(bs, wheel, spec)
         if self.periodic:
@@ -510,7 +522,7 @@ class Testbed:
         s, loop = self.spec, self._loop
         t = self.scene.time
         phase = loop["phase"]
-        omega = s.angular_velocity
+        omega = self.spin_command
         if phase == "spin-up":
             ramp = min(1.0, (t - loop["t_spin"]) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
             spin, carriage = omega * ramp, self.travel_speed * ramp
@@ -571,12 +583,13 @@ class Testbed:
             "torque": -(moment @ self.axle),
             "sinkage": self.bed.surface_height + r - hub[2],
             "tread_sinkage": self.bed.surface_height - float(nodes[self._tread_nodes, 2].min()),
-            "slip": 1.0 - vx / (r * spin) if spin > 0 else 0.0,
+            "slip": longitudinal_slip(vx, spin, r),
             "slip_angle": slip_angle_deg(vel, self.heading, self.axle),
-            "tread_slip": 1.0 - vx_tread / (r * tread_omega) if tread_omega > 0 else 0.0,
+            "tread_slip": longitudinal_slip(vx_tread, tread_omega, r),
             "tread_slip_angle": slip_angle_deg(vel, tread.heading, tread.axle),
             "wind_up": tread.wind_up,
             "tread_omega": tread_omega,
+            "heading_speed": vx_tread,
             "load": s.load if phase != "lower" else 0.0,
             "omega": spin,
             "travel": hub[0] + loop["shift"] - self.start_x,
@@ -610,7 +623,7 @@ class Testbed:
                 loop["windup_converged"] = self._wound_up()
                 self._hold(t)
         elif phase == "drive" and t >= loop["next_check"] - 1e-12:
-            loop["next_check"] = t + self.pitch / s.angular_velocity
+            loop["next_check"] = t + self.pitch / self.batch_rate
             ended = t >= loop["t_windup"] + s.drive_time - 1e-12
             if s.stop_when_steady or ended:
                 state = self._detect()
@@ -629,21 +642,21 @@ class Testbed:
         loop["phase"], loop["t_hold"] = "drive", t
         # the first window may start one whole period after the hold (the hub's step from the controller's
         # spin to omega is a small disturbance the wheel rides out within a period)
-        loop["t_average_from"] = t + self.pitch / self.spec.angular_velocity
+        loop["t_average_from"] = t + self.pitch / self.batch_rate
         loop["next_check"] = loop["t_average_from"] + self.spec.average_time
 
     def _wound_up(self) -> bool:
-        """The tread's spin over its last pitch gives the commanded slip within a third of the tolerance."""
+        """The tread's spin over its last pitch gives the commanded slip within a third of the tolerance, and
+        the controller's hub spin gives it within the tolerance (slips at the commanded travel speed)."""
         s, rows = self.spec, self.rows
         omega_t = np.asarray(rows["tread_omega"])
         t = np.asarray(rows["t"])
-        n_pitch = int(math.ceil(self.pitch / s.angular_velocity / (self.steps_per_sample * self.dt)))
+        n_pitch = int(math.ceil(self.pitch / self.batch_rate / (self.steps_per_sample * self.dt)))
         if len(t) < n_pitch or t[-n_pitch] < self._loop["t_windup"]:
             return False
-        mean_spin = float(omega_t[-n_pitch:].mean())
-        # slip error from a spin error: d i = (1 - i) d omega / omega
-        slip_error = (1.0 - s.slip) * abs(mean_spin - s.angular_velocity) / s.angular_velocity
-        spin_error = (1.0 - s.slip) * abs(self._loop["hub_spin"] - s.angular_velocity) / s.angular_velocity
+        v, r = rig_command(s.slip, s.angular_velocity, self.wheel.radius)[1], self.wheel.radius
+        slip_error = abs(longitudinal_slip(v, float(omega_t[-n_pitch:].mean()), r) - s.slip)
+        spin_error = abs(longitudinal_slip(v, self._loop["hub_spin"], r) - s.slip)
         return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
 
     def _window_long_enough(self, state: SteadyState) -> bool:
@@ -778,15 +791,22 @@ class _ProgressBar:
                 f"Fz {rows['vertical_force'][-1]:8.1f} N  T {rows['torque'][-1]:7.1f} N m  "
                 f"sinkage {1e3 * rows['sinkage'][-1]:6.1f} mm")
         if loop["phase"] in ("wind-up", "drive"):
-            n = max(1, int(b.pitch / s.angular_velocity / (b.steps_per_sample * b.dt)))
+            n = max(1, int(b.pitch / b.batch_rate / (b.steps_per_sample * b.dt)))
             omega_t = float(np.mean(rows["tread_omega"][-n:]))
-            slip = 1.0 - b.travel_speed * math.cos(math.radians(s.slip_angle)) / (b.wheel.radius * omega_t) \
-                if omega_t > 0 else math.nan
+            slip = longitudinal_slip(b.travel_speed * math.cos(math.radians(s.slip_angle)), omega_t, b.wheel.radius)
             text += f"  tread slip {slip:.3f} (commanded {s.slip:g})"
         self.bar.update(self.task, total=total, completed=completed, description=text)
 
     def stop(self) -> None:
         self.bar.stop()
+
+
+def batch_rate(slip: float, reference_spin: float, radius: float) -> float:
+    """The rate [rad/s] at which the steady-state statistics' batches (pitches) pass under the rig's command:
+    the hub's commanded spin (:func:`.kinematics.rig_command`), or for a wheel dragged without turning (i = -1)
+    the angle it would roll through at its travel speed, v_x / r."""
+    spin, heading_speed = rig_command(slip, reference_spin, radius)
+    return spin if spin > 0.0 else heading_speed / radius
 
 
 def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: float, average_time: float,
@@ -797,8 +817,8 @@ def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: 
     :data:`SERIES_UNITS`) -- what a running testbed asks once per pitch, and what a stored run's ``series.csv``
     can be asked again (``docs/steady_replay.py``).
 
-    slip, load [N], angular_velocity [rad/s], average_time [s], steady_tolerance, slip_tolerance: the rig's
-    settings (:class:`TestbedSpec`); radius [m], pitch [rad] (the batch: :func:`statistics_pitch`) and
+    slip, load [N], angular_velocity [rad/s] (the reference spin), average_time [s], steady_tolerance,
+    slip_tolerance: the rig's settings (:class:`TestbedSpec`); radius [m], pitch [rad] (the batch: :func:`statistics_pitch`) and
     period_pitches (its whole period in batches): the wheel's; mean_diameter [m]: the soil's mean particle
     diameter (half of it is the sinkage's floor); sample_interval [s]; start [s]: earliest window start.
     The floors of the relative tolerance are 5 % of W for the forces, 5 % of W r for the torque.
@@ -808,14 +828,22 @@ def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: 
     floors = {"drawbar_pull": 0.05 * load, "lateral_force": 0.05 * load, "vertical_force": 0.05 * load,
               "torque": 0.05 * load * radius, "sinkage": 0.5 * mean_diameter}
     t = np.asarray(rows["t"], float)
-    # the tread angle from its per-sample spin, and the travel speed along the tread's heading (the v_x
-    # of the tread slip i_t = 1 - v_x / (r omega_t), recovered from the two series)
+    # the tread angle from its per-sample spin, and the travel speed along the tread's heading (recorded; a
+    # series stored before it was, from runs that only drove, recovered from i_t = 1 - v_x / (r omega_t))
     omega_t = np.asarray(rows["tread_omega"], float)
-    heading_speed = (1.0 - np.asarray(rows["tread_slip"], float)) * radius * omega_t
+    if "heading_speed" in rows:
+        heading_speed = np.asarray(rows["heading_speed"], float)
+    else:
+        heading_speed = (1.0 - np.asarray(rows["tread_slip"], float)) * radius * omega_t
     angle = np.cumsum(omega_t * sample_interval)
-    min_pitches = int(math.ceil(average_time * angular_velocity / pitch))
+    rate = batch_rate(slip, angular_velocity, radius)
+    # a dragged wheel does not turn: its batches are the angles it would roll through along its travel
+    batch_angle = angle if rig_command(slip, angular_velocity, radius)[0] > 0.0 else \
+        np.asarray(rows["travel"], float) / radius
+    min_pitches = int(math.ceil(average_time * rate / pitch))
     return detect_steady_state(
-        t, series, tread_angle=angle, travel_speed=heading_speed, radius=radius, pitch=pitch, start=start,
+        t, series, tread_angle=angle, batch_angle=batch_angle, travel_speed=heading_speed, radius=radius,
+        pitch=pitch, start=start,
         min_pitches=min_pitches, tolerance=steady_tolerance, floors=floors, slip_target=slip,
         slip_tolerance=slip_tolerance, sample_interval=sample_interval, period_pitches=period_pitches,
         truncation_search=truncation_search)

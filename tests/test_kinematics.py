@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from wheelsoil.coupling.kinematics import TreadTracker, slip_angle_deg, tread_slip
+from wheelsoil.coupling.kinematics import TreadTracker, longitudinal_slip, rig_command, slip_angle_deg
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.rigid_motion import deformation, rigid_fit, rotation_about, rotation_vector
 from wheelsoil.flexwheel.statics import rotation_matrices
@@ -72,11 +72,23 @@ def test_tread_tracker_measures_the_wind_up_and_the_tread_yaw(beta_deg, lag_deg,
     assert slip_angle_deg([0.4, 0.0, 0.0], state.heading, state.axle) == pytest.approx(beta_deg - yaw_deg, abs=0.1)
 
 
-def test_tread_slip_and_slip_angle_definitions():
-    # seed 004 eq. 14: i = 1 - v / (r omega)
-    assert tread_slip(0.42, 1.0, 0.6) == pytest.approx(0.3)
-    assert tread_slip(0.42, 0.0, 0.6) == 0.0
-    assert np.allclose(tread_slip([0.42, 0.6], [1.0, 1.0], 0.6), [0.3, 0.0])
+def test_slip_and_slip_angle_definitions():
+    # driving, seed 004 eq. 14: i = 1 - v / (r omega)
+    assert longitudinal_slip(0.42, 1.0, 0.6) == pytest.approx(0.3)
+    # braking, the CMU rig's convention (its README): i = r omega / v - 1; dragged without turning: -1
+    assert longitudinal_slip(0.6, 0.5, 0.6) == pytest.approx(-0.5)
+    assert longitudinal_slip(0.42, 0.0, 0.6) == -1.0
+    assert longitudinal_slip(0.0, 0.0, 0.6) == 0.0
+    assert np.allclose(longitudinal_slip([0.42, 0.6, 0.9], [1.0, 1.0, 1.0], 0.6), [0.3, 0.0, 0.6 / 0.9 - 1.0])
+    # the CMU trials' own rows: carriage 10 mm/s, rim speeds 0, 5, 10, 20, 40 mm/s
+    rim = np.array([0.0, 5.0, 10.0, 20.0, 40.0])
+    assert np.allclose(longitudinal_slip(10.0, rim, 1.0), [-1.0, -0.5, 0.0, 0.5, 0.75])
+    # the rig's command gives back its slip on both branches, and meets itself at i = 0
+    for slip in (-1.0, -0.7, -0.2, 0.0, 0.3, 0.9):
+        spin, v = rig_command(slip, 2.0, 0.058)
+        assert longitudinal_slip(v, spin, 0.058) == pytest.approx(slip, abs=1e-12)
+    assert rig_command(-1e-12, 2.0, 0.058) == pytest.approx(rig_command(0.0, 2.0, 0.058))
+    assert rig_command(-1.0, 2.0, 0.058) == (0.0, pytest.approx(0.116))
     assert slip_angle_deg([1.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]) == pytest.approx(45.0)
     # rotation_about: a ring turned by 0.3 rad about y
     x = _ring()

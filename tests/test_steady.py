@@ -352,3 +352,35 @@ def test_a_quantity_constant_to_round_off_does_not_choose_the_window():
         assert windows == {(alone.k0, alone.k1)}
     assert not varies(np.full(8, 0.3) + 1e-16 * np.arange(8)) and varies(np.array([0.3, 0.3001]))
     assert not varies(np.zeros(5))
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("slip", [-0.5, -0.2])
+def test_a_braking_run_reports_the_rigs_braking_slip(seed, slip):
+    """Braking (the measured rigs' convention, i = r omega_t / v - 1): the carriage at v = r omega_0, the
+    tread turning at (1 + i) omega_0; the window is whole pitches of the tread and its slip is the commanded."""
+    t, series, _, _ = synthetic_run(seed)
+    spin = np.full(t.size, (1.0 + slip) * OMEGA)
+    speed = np.full(t.size, R * OMEGA)
+    angle = np.cumsum(spin * DT)
+    state = detect(t, series, angle, speed, slip_target=slip)
+    assert state.steady, state.reasons
+    assert state.tread_slip == pytest.approx(slip, abs=1e-9)
+    assert (angle[state.k1 - 1] - angle[state.k0 - 1]) / PITCH == pytest.approx(state.pitches, abs=0.05)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_dragged_wheel_is_batched_by_its_travel_and_reports_slip_minus_one(seed):
+    """A wheel dragged without turning (i = -1) has no tread pitches: the batches are the angles it would roll
+    through along its travel (batch_angle = travel / r), and its slip is -1 exactly."""
+    t, series, _, _ = synthetic_run(seed)
+    speed = np.full(t.size, R * OMEGA)
+    rolled = np.cumsum(speed * DT) / R
+    still = np.zeros(t.size)
+    state = detect(t, series, still, speed, batch_angle=rolled, slip_target=-1.0)
+    assert state.steady, state.reasons
+    assert state.tread_slip == -1.0
+    assert (rolled[state.k1 - 1] - rolled[state.k0 - 1]) / PITCH == pytest.approx(state.pitches, abs=0.05)
+    # the tread's own angle alone gives no pitch to batch by, and says so
+    refused = detect(t, series, still, speed, slip_target=-1.0)
+    assert not refused.steady and "has not yet turned" in refused.reasons[0]
