@@ -202,9 +202,14 @@ class Test(_Section):
     slip: float = _q(smoke.TEST["slip"], "1", "longitudinal slip: driving i = 1 - v_x / (r omega); braking (< 0) "
                      "i = r omega / v_x - 1, -1 a wheel dragged without turning",
                      _TEST["slip"])
+    slip_speed: Literal["heading", "travel"] = Field(
+        "heading", description="the travel speed the slip is taken against: 'heading' (v_x, along the wheel's "
+                               "heading) or 'travel' (the carriage's whole speed, as the measured rigs report slip; "
+                               "needed at slip_angle = 90)")
     slip_angle: float = _q(smoke.TEST["slip_angle"], "deg", "steering (slip) angle beta between heading and travel",
                            _TEST["slip_angle"])
     load: float = _q(smoke.TEST["load"], "N", "vertical load W on the soil, wheel weight included", _TEST["load"])
+
     angular_velocity: float = _q(smoke.TEST["angular_velocity"], "rad/s", "reference spin omega_0: the hub's spin when "
                                  "driving; braking, the carriage travels at r omega_0 and the hub spins at (1 + i) omega_0",
                                  _TEST["angular_velocity"])
@@ -230,6 +235,14 @@ class Test(_Section):
                                              "middle of a periodic bin)", _TEST["start_x"])
     axle_damping: Optional[float] = _q(None, "N s/m", "damper on the rig's vertical slide (default: wheel "
                                                       "mass / 0.1 s)", _TEST["axle_damping"])
+
+    @field_validator("slip_angle")
+    @classmethod
+    def _sideways_needs_travel(cls, value, info: ValidationInfo):
+        if info.data.get("slip_speed") == "heading" and abs(value) >= 90.0:
+            raise ValueError("needs slip_speed = 'travel': at 90 deg the speed along the heading is zero, so the "
+                             "slip is taken against the carriage's whole speed")
+        return value
 
 
 class Output(_Section):
@@ -278,6 +291,9 @@ class CaseFile(BaseModel):
         data = self.model_dump(mode="json")
         data["case"].pop("name")
         data["case"].pop("description")
+        # keys added after cases were stored leave a case's hash as it was while they hold their default
+        if data["test"]["slip_speed"] == "heading":
+            data["test"].pop("slip_speed")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 

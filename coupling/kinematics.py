@@ -108,8 +108,9 @@ def rig_command(slip: float, reference_spin: float, radius: float) -> tuple[floa
 
 
 def slip_angle_deg(velocity, heading, axle) -> float:
-    """Angle [deg] between a heading and the horizontal travel velocity: atan2(v . axle, v . heading)."""
+    """Angle [deg] between a heading and the horizontal travel velocity: atan2(v . axle, v . heading) (90 for a
+    wheel ploughing sideways); 0 when it does not travel."""
     v = np.asarray(velocity, float).copy()
     v[2] = 0.0
     vx, vy = float(v @ heading), float(v @ axle)
-    return math.degrees(math.atan2(vy, vx)) if abs(vx) > 1e-12 else 0.0
+    return math.degrees(math.atan2(vy, vx)) if math.hypot(vx, vy) > 1e-12 else 0.0

@@ -90,7 +90,7 @@ SERIES_UNITS = {
     "tread_slip_angle": "deg",
     "wind_up": "rad",
     "tread_omega": "rad/s",
-    "heading_speed": "m/s",
+    "slip_speed": "m/s",
     "load": "N",
     "omega": "rad/s",
     "travel": "m",
@@ -99,6 +99,8 @@ SERIES_UNITS = {
     "hub_z": "m",
     "contacts": "1",
 }
+#: What the slip may be taken against (:class:`TestbedSpec` ``slip_speed``).
+SLIP_SPEEDS = ("heading", "travel")
 #: Quantities whose drift the steady-state detector checks (the tread slip is checked on its own).
 STEADY_CHECKED = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage")
 #: Quantities averaged over the steady window.
@@ -117,7 +119,13 @@ class TestbedSpec:
 
     slip: commanded longitudinal slip in [-1, 1): driving (>= 0) i = 1 - v_x / (r omega); braking (< 0)
         i = r omega / v_x - 1, -1 a wheel dragged without turning (the measured rigs' convention).
-    slip_angle: steering angle beta between heading and travel [deg], in (-90, 90).
+    slip_angle: steering angle beta between heading and travel [deg], in (-90, 90]; 90 (the wheel ploughing
+        sideways) only with ``slip_speed = "travel"``.
+    slip_speed: the travel speed v the slip is taken against: ``"heading"`` (the architecture's v_x, the
+        travel velocity's component along the heading; the carriage then moves at v_x / cos beta) or
+        ``"travel"`` (the measured rigs': the carriage's whole horizontal speed V, as the CMU rig reports slip:
+        at 60 deg a rim speed of 20 mm/s against a 10 mm/s carriage is i = 0.5; its model's v_jt.m takes
+        r omega >= V as the slip condition). Equal at beta = 0.
     load: vertical load W on the soil, wheel weight included [N], > 0.
     angular_velocity: the rig's reference spin omega_0 [rad/s], > 0 (seed 004: r omega = 0.6 m/s): the hub's
         spin when driving; when braking the carriage travels at r omega_0 and the hub spins at (1 + i) omega_0.
@@ -163,6 +171,7 @@ class TestbedSpec:
 
     slip: float = smoke.TEST["slip"]
     slip_angle: float = smoke.TEST["slip_angle"]
+    slip_speed: str = "heading"
     load: float = smoke.TEST["load"]
     angular_velocity: float = smoke.TEST["angular_velocity"]
     lowering_speed: float = smoke.TEST["lowering_speed"]
@@ -191,7 +200,7 @@ class TestbedSpec:
     #: schema's [test], [output] and wheel.damping fields take their bounds from here.
     RANGES: ClassVar[dict[str, Range]] = {
         "slip": Range(-1.0, 1.0, hi_open=True),
-        "slip_angle": Range(-90.0, 90.0, lo_open=True, hi_open=True),
+        "slip_angle": Range(-90.0, 90.0, lo_open=True),
         "load": positive(),
         "angular_velocity": positive(),
         "lowering_speed": positive(),
@@ -222,6 +231,10 @@ class TestbedSpec:
     def __post_init__(self) -> None:
         check_ranges(self, self.RANGES, "testbed", self.UNITS)
         _check("windup", self.windup, self.windup in ("controller", "none"), "'controller' or 'none'")
+        _check("slip_speed", self.slip_speed, self.slip_speed in SLIP_SPEEDS, " or ".join(map(repr, SLIP_SPEEDS)))
+        _check("slip_angle", self.slip_angle, abs(self.slip_angle) < 90.0 or self.slip_speed == "travel",
+               "-90 < slip_angle < 90 deg with slip_speed = 'heading' (at 90 deg the heading speed is zero: take "
+               "the slip against the travel, slip_speed = 'travel', the measured rigs' convention)")
         _check("average_time", self.average_time, self.average_time < self.drive_time,
                f"average_time < drive_time = {self.drive_time} s")
         _check("sample_interval", self.sample_interval, self.sample_interval <= 0.25 * self.average_time,
@@ -233,6 +246,18 @@ class TestbedSpec:
         d = asdict(self)
         d["pair"] = self.pair.to_dict()
         return d
+
+
+def carriage_speed(spec: TestbedSpec, radius: float) -> tuple[float, float]:
+    """The hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] that give the commanded
+    slip (:func:`.kinematics.rig_command`) against the speed ``spec.slip_speed`` names: the speed along the
+    heading is v cos beta when the carriage moves at v, so with ``"heading"`` the carriage moves at v_x / cos beta,
+    with ``"travel"`` at V itself (velocity components, never through tan beta: 90 deg is a wheel ploughing
+    sideways)."""
+    spin, speed = rig_command(spec.slip, spec.angular_velocity, radius)
+    if spec.slip_speed == "heading":
+        speed /= math.cos(math.radians(spec.slip_angle))
+    return spin, speed
 
 
 def yaw_matrix(angle_rad: float) -> np.ndarray:
@@ -345,7 +370,7 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     if bed.periodic:
         shift = spec.patch_shift or 0.2 * wheel.radius
         return PatchGeometry.for_wheel(bed.length, outer, shift, bed.diameter_max).check(spec.start_x)
-    speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)[1] / math.cos(beta)
+    speed = carriage_speed(spec, wheel.radius)[1]
     travel = abs(speed) * (spec.drive_time + spec.spin_up_time)
     start_x = spec.start_x if spec.start_x is not None else outer + 0.1
     if start_x - outer < 0 or start_x + travel + outer > bed.length:
@@ -390,8 +415,7 @@ class Testbed:
         self.outer_radius = outer
         self.gravity = -float(bs.gravity[2])
         # the hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] (kinematics.rig_command)
-        self.spin_command, heading_speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)
-        self.travel_speed = heading_speed / math.cos(beta)
+        self.spin_command, self.travel_speed = carriage_speed(spec, wheel.radius)
         #: the rate [rad/s] at which the statistics' batches pass: the hub's spin, or for a dragged wheel (no
         #: spin) the angle it would roll through at its travel speed
         self.batch_rate = batch_rate(spec.slip, spec.angular_velocity, wheel.radius)
@@ -574,6 +598,8 @@ class Testbed:
         loop["omega_filtered"] += (tread_omega - loop["omega_filtered"]) * min(1.0, interval / s.windup_filter)
         vx = float(vel @ self.heading)
         vx_tread = float(vel @ tread.heading)
+        if self.spec.slip_speed == "travel":  # the whole horizontal travel speed, the same for hub and tread
+            vx = vx_tread = float(math.hypot(vel[0], vel[1]))
         r = self.wheel.radius
         return {
             "t": self.scene.time,
@@ -589,7 +615,7 @@ class Testbed:
             "tread_slip_angle": slip_angle_deg(vel, tread.heading, tread.axle),
             "wind_up": tread.wind_up,
             "tread_omega": tread_omega,
-            "heading_speed": vx_tread,
+            "slip_speed": vx_tread,
             "load": s.load if phase != "lower" else 0.0,
             "omega": spin,
             "travel": hub[0] + loop["shift"] - self.start_x,
@@ -654,7 +680,8 @@ class Testbed:
         n_pitch = int(math.ceil(self.pitch / self.batch_rate / (self.steps_per_sample * self.dt)))
         if len(t) < n_pitch or t[-n_pitch] < self._loop["t_windup"]:
             return False
-        v, r = rig_command(s.slip, s.angular_velocity, self.wheel.radius)[1], self.wheel.radius
+        r = self.wheel.radius
+        v = rig_command(s.slip, s.angular_velocity, r)[1]  # the speed the slip is taken against
         slip_error = abs(longitudinal_slip(v, float(omega_t[-n_pitch:].mean()), r) - s.slip)
         spin_error = abs(longitudinal_slip(v, self._loop["hub_spin"], r) - s.slip)
         return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
@@ -793,7 +820,8 @@ class _ProgressBar:
         if loop["phase"] in ("wind-up", "drive"):
             n = max(1, int(b.pitch / b.batch_rate / (b.steps_per_sample * b.dt)))
             omega_t = float(np.mean(rows["tread_omega"][-n:]))
-            slip = longitudinal_slip(b.travel_speed * math.cos(math.radians(s.slip_angle)), omega_t, b.wheel.radius)
+            v = rig_command(s.slip, s.angular_velocity, b.wheel.radius)[1]
+            slip = longitudinal_slip(v, omega_t, b.wheel.radius)
             text += f"  tread slip {slip:.3f} (commanded {s.slip:g})"
         self.bar.update(self.task, total=total, completed=completed, description=text)
 
@@ -828,18 +856,19 @@ def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: 
     floors = {"drawbar_pull": 0.05 * load, "lateral_force": 0.05 * load, "vertical_force": 0.05 * load,
               "torque": 0.05 * load * radius, "sinkage": 0.5 * mean_diameter}
     t = np.asarray(rows["t"], float)
-    # the tread angle from its per-sample spin, and the travel speed along the tread's heading (recorded; a
+    # the tread angle from its per-sample spin, and the speed the tread slip is taken against (recorded; a
     # series stored before it was, from runs that only drove, recovered from i_t = 1 - v_x / (r omega_t))
     omega_t = np.asarray(rows["tread_omega"], float)
-    if "heading_speed" in rows:
-        heading_speed = np.asarray(rows["heading_speed"], float)
+    if "slip_speed" in rows:
+        heading_speed = np.asarray(rows["slip_speed"], float)
     else:
         heading_speed = (1.0 - np.asarray(rows["tread_slip"], float)) * radius * omega_t
     angle = np.cumsum(omega_t * sample_interval)
     rate = batch_rate(slip, angular_velocity, radius)
-    # a dragged wheel does not turn: its batches are the angles it would roll through along its travel
+    # a dragged wheel does not turn: its batches are the angles it would roll through at the speed its slip is
+    # taken against (batch_rate)
     batch_angle = angle if rig_command(slip, angular_velocity, radius)[0] > 0.0 else \
-        np.asarray(rows["travel"], float) / radius
+        np.cumsum(heading_speed * sample_interval) / radius
     min_pitches = int(math.ceil(average_time * rate / pitch))
     return detect_steady_state(
         t, series, tread_angle=angle, batch_angle=batch_angle, travel_speed=heading_speed, radius=radius,

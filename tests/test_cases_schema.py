@@ -46,8 +46,9 @@ def test_unknown_keys_and_sections_suggest_the_closest_valid_one(tmp_path):
 
 @pytest.mark.parametrize("text, key, value, allowed", [
     ("[test]\nslip = 1.5", "test.slip", "1.5", "allowed slip >= -1 and < 1"),
-    ("[test]\nslip_angle = -95", "test.slip_angle", "-95", "allowed slip_angle > -90 and < 90; unit deg"),
+    ("[test]\nslip_angle = -95", "test.slip_angle", "-95", "allowed slip_angle > -90 and <= 90; unit deg"),
     ("[test]\nload = 0", "test.load", "0", "allowed load > 0; unit N"),
+    ("[test]\nslip_angle = 90", "test.slip_angle", "90", "needs slip_speed = 'travel'"),
     ("[soil]\npoisson_ratio = 0.5", "soil.poisson_ratio", "0.5", "allowed poisson_ratio > -1 and < 0.5"),
     ("[contact]\nrestitution = 1.2", "contact.restitution", "1.2", "allowed restitution > 0 and <= 1"),
     ("[output]\nframe_interval = -1", "output.frame_interval", "-1", "allowed frame_interval >= 0; unit s"),

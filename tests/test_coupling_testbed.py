@@ -94,25 +94,33 @@ def test_rigid_wheel_tread_turns_with_the_hub(mini_bed):
     assert np.allclose(result.series["tread_slip_angle"][drive], 10.0, atol=1e-6)
 
 
-@pytest.mark.slow  # two 30 s runs
-@pytest.mark.parametrize("slip", [-1.0, -0.5])
-def test_braking_and_dragged_wheels_follow_the_rigs_convention(mini_bed, slip):
-    """Braking by the measured rigs' convention (architecture; the CMU rig's README): the carriage travels at
-    r omega_0 and the hub spins at (1 + i) omega_0, so i = -1 is a wheel dragged without turning. A rigid wheel's
-    measured hub and tread slips are the commanded one, and the soil resists: drawbar pull < 0; the dragged
-    wheel's rig holds it against the soil's turning moment (torque < 0)."""
-    bench = Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, rigid=True, slip=slip, slip_angle=0.0, windup="none",
-                                                  drive_time=0.15, average_time=0.05))
+@pytest.mark.slow  # three 30 s runs
+@pytest.mark.parametrize("slip, beta", [(-1.0, 0.0), (-0.5, 0.0), (0.5, 90.0)])
+def test_braking_dragged_and_sideways_wheels_follow_the_rigs_convention(mini_bed, slip, beta):
+    """The measured rigs' convention (architecture; the CMU rig's README), slip taken against the carriage's
+    whole speed: braking, the carriage travels at r omega_0 and the hub spins at (1 + i) omega_0, so i = -1 is a
+    wheel dragged without turning; at 90 deg the wheel ploughs sideways. A rigid wheel's measured hub and tread
+    slips are the commanded one and its slip angle the commanded; the soil resists the travel: a braked or
+    dragged wheel has drawbar pull < 0, the dragged wheel's rig holds it against the soil's turning moment
+    (torque < 0), and the sideways wheel's lateral force opposes its travel (< 0)."""
+    bench = Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, rigid=True, slip=slip, slip_angle=beta, slip_speed="travel",
+                                                  windup="none", drive_time=0.15, average_time=0.05))
     result = bench.run()
     drive = result.series["t"] > result.info["t_wind_up"] + 0.01
     r, omega0 = MINI_WHEEL.radius, MINI_RUN.angular_velocity
-    assert np.allclose(result.series["omega"][drive], (1.0 + slip) * omega0, atol=1e-9)
-    assert bench.travel_speed == pytest.approx(r * omega0)
-    assert np.allclose(result.series["slip"][drive], slip, atol=1e-6)
-    assert np.allclose(result.series["tread_slip"][drive], slip, atol=1e-6)
-    assert result.summary["drawbar_pull"]["mean"] < 0.0
+    spin, speed = (omega0, (1.0 - slip) * r * omega0) if slip >= 0 else ((1.0 + slip) * omega0, r * omega0)
+    assert np.allclose(result.series["omega"][drive], spin, atol=1e-9)
+    assert bench.travel_speed == pytest.approx(speed)
+    for q in ("slip", "tread_slip"):
+        assert np.allclose(result.series[q][drive], slip, atol=1e-6), q
+    assert np.allclose(result.series["slip_angle"][drive], beta, atol=1e-6)
+    s = result.summary
+    if slip < 0.0:
+        assert s["drawbar_pull"]["mean"] < 0.0
     if slip == -1.0:
-        assert result.summary["torque"]["mean"] < 0.0
+        assert s["torque"]["mean"] < 0.0
+    if beta == 90.0:
+        assert s["lateral_force"]["mean"] < 0.0
 
 
 @pytest.mark.parametrize(
@@ -122,6 +130,8 @@ def test_braking_and_dragged_wheels_follow_the_rigs_convention(mini_bed, slip):
         (dict(slip=-1.5), "slip"),
         (dict(slip_angle=90.0), "slip_angle"),
         (dict(slip_angle=-95.0), "slip_angle"),
+        (dict(slip_angle=-90.0, slip_speed="travel"), "slip_angle"),
+        (dict(slip_speed="sideways"), "slip_speed"),
         (dict(load=0.0), "load"),
         (dict(load=-10.0), "load"),
         (dict(angular_velocity=0.0), "angular_velocity"),
@@ -136,6 +146,28 @@ def test_braking_and_dragged_wheels_follow_the_rigs_convention(mini_bed, slip):
 def test_bad_rig_settings_name_the_key_value_and_range(change, key):
     with pytest.raises(WheelsoilInputError, match=rf"testbed {key} = .* allowed"):
         replace(MINI_RUN, **change)
+
+
+@pytest.mark.parametrize("slip, beta, reference, spin, speed", [
+    (0.5, 60.0, "travel", 2.0, 0.15),           # the CMU rig at 60 deg: rim 2 x carriage is i = 0.5
+    (0.5, 60.0, "heading", 2.0, 0.3),           # the architecture's: v_x = 0.15 along the heading, 0.3 along the bin
+    (-0.5, 0.0, "travel", 1.0, 0.3),            # braking: carriage at r omega_0, hub at half of omega_0
+    (-1.0, 90.0, "travel", 0.0, 0.3),           # dragged sideways
+    (0.9, 90.0, "travel", 2.0, 0.03),           # ploughing sideways at the CMU's highest slip
+])
+def test_the_carriage_and_hub_give_the_commanded_slip_against_the_named_speed(slip, beta, reference, spin, speed):
+    from wheelsoil.coupling.kinematics import longitudinal_slip, slip_angle_deg
+    from wheelsoil.coupling.testbed import carriage_speed
+
+    spec = replace(MINI_RUN, slip=slip, slip_angle=beta, slip_speed=reference)
+    hub_spin, along_bin = carriage_speed(spec, MINI_WHEEL.radius)
+    assert (hub_spin, along_bin) == (pytest.approx(spin), pytest.approx(speed))
+    # the wheel yawed by -beta: the carriage's velocity in the wheel frame, in components
+    b = np.radians(beta)
+    v_x, v_y = along_bin * np.cos(b), along_bin * np.sin(b)
+    v = np.hypot(v_x, v_y) if reference == "travel" else v_x
+    assert longitudinal_slip(v, hub_spin, MINI_WHEEL.radius) == pytest.approx(slip, abs=1e-12)
+    assert slip_angle_deg([v_x, v_y, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]) == pytest.approx(beta)
 
 
 def test_wheel_wider_than_the_bin_short_bin_and_missing_bed_are_refused(mini_bed, tmp_path):
