@@ -691,13 +691,12 @@ def _torsion_tests(geometry, mesh, args, out, console) -> dict:
 
 
 def _plot_torsion(curves, path, name):
-    import matplotlib
     import numpy as np
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from wheelsoil.plotting import pyplot
     from wheelsoil.provenance import atomic_output
+
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(5.5, 4))
     span = max(abs(float(np.max(np.abs(c.twist)))) for c in curves)
@@ -728,13 +727,12 @@ def _progress(console):
 
 
 def _plot_load_curves(curves, geometry, path):
-    import matplotlib
     import numpy as np
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from wheelsoil.plotting import pyplot
     from wheelsoil.provenance import atomic_output
+
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for c in curves:

@@ -7,15 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from wheelsoil.gravity import gravity_label
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+from wheelsoil.plotting import pyplot
 
 
 def plot_series(result, path: str | Path, title: str) -> Path:
@@ -27,7 +19,7 @@ def plot_series(result, path: str | Path, title: str) -> Path:
     """
     from wheelsoil.provenance import atomic_output
 
-    plt = _pyplot()
+    plt = pyplot()
     s, t = result.series, result.series["t"]
     fig, axes = plt.subplots(4, 1, figsize=(7, 9), sharex=True)
     for name in ("drawbar_pull", "lateral_force", "vertical_force"):
@@ -79,7 +71,7 @@ def plot_sweep(table, out: str | Path, title: str) -> list[Path]:
     Returns the paths."""
     from wheelsoil.provenance import atomic_output
 
-    plt = _pyplot()
+    plt = pyplot()
     out = Path(out)
     angles = sorted(table["slip_angle_set"].unique())
     groups = sorted({(g, w, bool(r)) for g, w, r in zip(table["gravity"], table["load_set"], table["rigid"])},

@@ -113,10 +113,9 @@ def difference(a: float, b: float) -> float:
 
 
 def make_figures(res: dict, figures: Path) -> dict:
-    import matplotlib
+    from wheelsoil.plotting import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     figures.mkdir(parents=True, exist_ok=True)
     found = {}

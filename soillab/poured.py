@@ -13,11 +13,9 @@ import dataclasses
 import time
 from dataclasses import dataclass
 
-import numpy as np
-
 from wheelsoil.granular.bed import BedSpec, prepare_bed
 
-from .specs import check_seeds
+from .specs import check_seeds, mean_and_spread
 
 
 @dataclass(frozen=True)
@@ -43,13 +41,12 @@ class PouredBedResult:
     @property
     def bulk_density(self) -> tuple[float, float]:
         """Mean and standard deviation (over seeds) of the bulk density [kg/m^3]."""
-        values = np.array([b.bulk_density for b in self.beds])
-        return float(values.mean()), float(values.std(ddof=1)) if len(values) > 1 else float("nan")
+        return mean_and_spread(b.bulk_density for b in self.beds)
 
     @property
     def packing_fraction(self) -> tuple[float, float]:
-        values = np.array([b.packing_fraction for b in self.beds])
-        return float(values.mean()), float(values.std(ddof=1)) if len(values) > 1 else float("nan")
+        """Mean and standard deviation (over seeds) of the packing fraction [-]."""
+        return mean_and_spread(b.packing_fraction for b in self.beds)
 
 
 def poured_bed_test(bed_spec: BedSpec, seeds=(0, 1, 2), *, cache_dir=None, arch: str | None = None,

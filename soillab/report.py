@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from wheelsoil.parameters import cmu_k10
+from wheelsoil.plotting import pyplot
 from wheelsoil.provenance import atomic_output, provenance
 
 from .bearing import circular_footing
@@ -22,15 +23,6 @@ from .repose import ReposeResult
 from .shear import ShearResult
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _write(folder: Path, name: str, table: pd.DataFrame, figures: dict, fig) -> dict[str, Path]:
     folder.mkdir(parents=True, exist_ok=True)
     paths = {ext: folder / f"{name}.{ext}" for ext in ("csv", "json", "png")}
@@ -40,7 +32,7 @@ def _write(folder: Path, name: str, table: pd.DataFrame, figures: dict, fig) -> 
         tmp.write_text(json.dumps({"test": name, **figures, "provenance": provenance()}, indent=2, default=float))
     with atomic_output(paths["png"]) as tmp:
         fig.savefig(tmp, dpi=120, bbox_inches="tight", format="png")
-    _pyplot().close(fig)
+    pyplot().close(fig)
     return paths
 
 
@@ -51,7 +43,7 @@ def write_poured(result: PouredBedResult, folder: Path) -> tuple[dict, dict[str,
     figures = {"bulk_density_kg_m3": mean, "bulk_density_sd_kg_m3": sd, "packing_fraction": phi,
                "packing_fraction_sd": phi_sd, "measured_bulk_density_kg_m3": cmu_k10.BULK_DENSITY,
                "relative_error": mean / cmu_k10.BULK_DENSITY - 1.0, "seeds": [b.seed for b in result.beds]}
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5, 3.5))
     ax.bar([str(b.seed) for b in result.beds], [b.bulk_density for b in result.beds], color="tab:brown")
     ax.axhline(cmu_k10.BULK_DENSITY, color="k", ls="--", label="CMU sand, measured")
@@ -69,7 +61,7 @@ def write_repose(result: ReposeResult, folder: Path) -> tuple[dict, dict[str, Pa
     figures = {"method": "draw-down (ledge), periodic across the width", "angle_deg": mean, "angle_sd_deg": sd,
                "angles_deg": [r.angle for r in result.runs], "at_rest": [r.at_rest for r in result.runs],
                "measured_angle_deg": cmu_k10.ANGLE_OF_REPOSE, "difference_deg": mean - cmu_k10.ANGLE_OF_REPOSE}
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.5))
     for r in result.runs:
         line = ax.plot(r.position, r.height, label=f"seed {r.seed}: {r.angle:.1f}°")[0]
@@ -94,7 +86,7 @@ def write_shear(result: ShearResult, folder: Path) -> tuple[dict, dict[str, Path
                          "shear_plane_normal_Pa": r.plane_normal, "peak_Pa": r.peak,
                          "peak_displacement_m": r.peak_displacement, "peak_reached": r.peak_reached,
                          "residual_Pa": r.residual, "wall_seconds": r.wall_seconds} for r in result.runs]}
-    plt = _pyplot()
+    plt = pyplot()
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 3.8))
     for r in result.runs:
         a.plot(1e3 * r.displacement, 1e-3 * r.shear_stress, label=f"σ = {1e-3 * r.normal_stress:g} kPa")
@@ -182,7 +174,7 @@ def write_penetration(results: list[PenetrationResult], measured: list[LoadCurve
         figures["pressure"] = pressure_errors(simulated, measured, [0.005, 0.01, 0.015, 0.02, 0.025])
         if friction_angle is not None:
             figures["bearing"] = [_bearing(r, friction_angle, cohesion) for r in results]
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     colours = {}
     for c in measured:

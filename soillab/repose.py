@@ -25,7 +25,7 @@ import numpy as np
 from wheelsoil.granular.bed import Bed, BedSpec, prepare_bed
 from wheelsoil.granular.scene import Scene
 
-from .specs import ReposeSpec, check_resolution
+from .specs import ReposeSpec, check_resolution, mean_and_spread
 
 
 @dataclass(frozen=True)
@@ -50,8 +50,7 @@ class ReposeResult:
     @property
     def angle(self) -> tuple[float, float]:
         """Mean angle [deg] and its standard deviation over the seeds."""
-        a = np.array([r.angle for r in self.runs])
-        return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else float("nan")
+        return mean_and_spread(r.angle for r in self.runs)
 
 
 def surface_profile(positions: np.ndarray, radii: np.ndarray, width: float, reach: float,

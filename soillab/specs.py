@@ -247,3 +247,12 @@ def inertial_number(strain_rate: float, diameter: float, pressure: float, densit
     """GDR MiDi's inertial number I = gamma_dot d / sqrt(p / rho_p) [-]: below about 1e-3 a granular flow is
     quasi-static (its stresses do not depend on the rate)."""
     return strain_rate * diameter / math.sqrt(pressure / density)
+
+
+def mean_and_spread(values) -> tuple[float, float]:
+    """Mean and sample standard deviation (ddof 1) of a result over seeds (packings); the spread is NaN for one."""
+    values = [float(v) for v in values]
+    mean = math.fsum(values) / len(values)
+    if len(values) < 2:
+        return mean, math.nan
+    return mean, math.sqrt(math.fsum((v - mean) ** 2 for v in values) / (len(values) - 1))

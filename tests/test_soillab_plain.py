@@ -12,7 +12,7 @@ from wheelsoil.soillab import (PlateSpec, ReposeSpec, ShearSpec, WheelPressSpec,
                                fit_power_law, load_plate_curves, load_wheel_curves, mean_curve, split_k)
 from wheelsoil.soillab.shapes import disc, square_ring
 from wheelsoil.soillab.specs import (MAX_OVERLAP_FRACTION, check_plate_fits, check_resolution, inertial_number,
-                                     max_normal_stress)
+                                     max_normal_stress, mean_and_spread)
 
 
 # ---------------------------------------------------------------------- Bekker
@@ -179,3 +179,13 @@ def test_plate_and_box_meshes():
     vertical = np.abs(walls[:, 2]) < 1e-15
     inward = np.einsum("ij,ij->i", walls[vertical], np.array([0.05, 0.05, 0.0]) - centroid[vertical])
     assert np.all(inward > 0)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_mean_and_spread_over_seeds_is_the_sample_mean_and_deviation(seed):
+    values = np.random.default_rng(seed).normal(20.0, 2.0, size=3 + seed)
+    mean, spread = mean_and_spread(iter(values))
+    assert mean == pytest.approx(values.mean(), rel=1e-12)
+    assert spread == pytest.approx(values.std(ddof=1), rel=1e-12)
+    one = mean_and_spread([values[0]])
+    assert one[0] == values[0] and np.isnan(one[1])

@@ -118,12 +118,10 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
     """report.md, findings.json and measured_vs_simulated.png in ``out``; returns the findings."""
     from pathlib import Path
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from wheelsoil.plotting import pyplot
     from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
+
+    plt = pyplot()
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

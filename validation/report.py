@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.plotting import pyplot
 from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
 from .discovery import (
@@ -32,15 +33,6 @@ def _save(fig, path: Path) -> None:
     with atomic_output(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
     plt.close(fig)
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def verdict_lines(findings: dict) -> list[str]:
@@ -92,7 +84,7 @@ def verdict_lines(findings: dict) -> list[str]:
 
 def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndarray, path: Path) -> None:
     """Predicted against measured, classical and final model, training and held-out rows."""
-    plt = _pyplot()
+    plt = pyplot()
     models = [("classical", d.baseline.soil)]
     if findings["final"]["mechanisms"]:
         models.append(("+ " + " + ".join(findings["final"]["mechanisms"]), d.final.soil))
@@ -117,7 +109,7 @@ def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndar
 
 def plot_residuals(findings: dict, d: Discovery, data: Measurements, path: Path) -> None:
     """Final-model residuals against the condition that carries most of each response's remaining trend."""
-    plt = _pyplot()
+    plt = pyplot()
     pred = model_responses(d.final.soil, data)
     unexplained = {u["response"]: u for u in findings["unexplained"]}
     fig, axes = plt.subplots(1, len(d.responses), figsize=(4.2 * len(d.responses), 3.6), squeeze=False)
@@ -145,7 +137,7 @@ def plot_residuals(findings: dict, d: Discovery, data: Measurements, path: Path)
 def plot_candidates(findings: dict, path: Path) -> None:
     """ΔBIC of every candidate at every selection step: green named, cyan accepted but partial, orange
     ambiguous, grey not passed."""
-    plt = _pyplot()
+    plt = pyplot()
     steps = findings["steps"]
     fig, axes = plt.subplots(1, len(steps), figsize=(6.5 * len(steps), 3.8), squeeze=False)
     for ax, s in zip(axes[0], steps):

@@ -89,10 +89,9 @@ def synthetic_periodic_report(hidden: str | None = None, *, seed: int = 0, repor
 
 def _amplitude_plot(amp: dict, path) -> None:
     """Fitted against measured amplitudes, one series per model (from :func:`explain_amplitudes`)."""
-    import matplotlib
+    from wheelsoil.plotting import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     measured = np.asarray(amp["measured"], float)
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
