@@ -67,7 +67,8 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
     ``wheel.rigid``/``wheel.damping``."""
     t, o, c = case.test, case.output, case.contact
     return TestbedSpec(
-        slip=t.slip, slip_angle=t.slip_angle, slip_speed=t.slip_speed, load=t.load, angular_velocity=t.angular_velocity,
+        slip=t.slip, slip_angle=t.slip_angle, slip_speed=t.slip_speed, load=t.load,
+        angular_velocity=t.angular_velocity,
         lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
         drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
         windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,

@@ -269,7 +269,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--memory-check", action="store_true", help="full tier: also step a seed-004-size bed")
     p.set_defaults(func=cmd_bench)
     p = sub.add_parser("wheel", help="mesh a preset wheel and load-test it against a flat plate",
-                       description="Mesh a preset wheel (lunar-rover: seed 004; exomars: seeds 000/001), write the "
+                       description="Mesh a preset wheel (lunar-rover: seed 004; exomars: seeds 000/001; the CMU rig's "
+                                   "cmu-k10-smooth and cmu-k10-grouser), write the "
                                    "mesh as VTU, and measure its radial stiffness: point-load stiffness at angles "
                                    "over one spoke pitch, and the load-deflection curve against a rigid flat plate "
                                    "over the spoke and midway between spokes; and its torsional stiffness (the hub's "
@@ -277,7 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "and corotational in both directions: how far the wheel winds up under a driving "
                                    "torque). Writes mesh.vtu, load_test.csv, load_test.png, torsion_test.csv, "
                                    "torsion_test.png and summary.json to --out.")
-    p.add_argument("preset", help="wheel preset: lunar-rover or exomars")
+    p.add_argument("preset", help="wheel preset: lunar-rover, exomars, cmu-k10-smooth or cmu-k10-grouser")
     p.add_argument("--element-size", type=float, default=None, help="target element edge [m] (default: the preset's)")
     p.add_argument("--out", type=Path, default=None, help="output folder (default wheelsoil-output/wheel-<preset>)")
     p.add_argument("--points", type=int, default=6, help="load steps of the plate curve (default 6)")

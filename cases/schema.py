@@ -150,13 +150,14 @@ class Soil(_Section):
         return tuple(g)
 
 
-WHEEL_PRESETS = ("lunar-rover", "exomars")
+WHEEL_PRESETS = ("lunar-rover", "exomars", "cmu-k10-smooth", "cmu-k10-grouser")
 
 
 class Wheel(_Section):
-    preset: Literal["lunar-rover", "exomars"] = Field(
-        smoke.WHEEL_PRESET, description="base wheel: lunar-rover (seed 004, r = 0.6 m) or exomars (seeds 000/001); "
-                                   "the keys below replace its dimensions")
+    preset: Literal["lunar-rover", "exomars", "cmu-k10-smooth", "cmu-k10-grouser"] = Field(
+        smoke.WHEEL_PRESET, description="base wheel: lunar-rover (seed 004, r = 0.6 m), exomars (seeds 000/001) or "
+                                   "the CMU rig's K10-mini, cmu-k10-smooth or cmu-k10-grouser (r = 0.058 m); the "
+                                   "keys below replace its dimensions")
     element_size: Optional[float] = _q(smoke.WHEEL["element_size"], "m", "target element edge of the mesh "
                                        "(preset's own: 0.018 m lunar-rover, 0.006 m exomars)", _WHEEL["element_size"])
     rigid: bool = Field(smoke.WHEEL["rigid"], description="use the rigid wheel with the same surface")

@@ -22,7 +22,7 @@ from typing import ClassVar
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.parameters import exomars, seed004
+from wheelsoil.parameters import cmu_k10, exomars, seed004
 from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
 from .beam import rectangular_section
@@ -295,11 +295,15 @@ LUNAR_ROVER = from_parameters(seed004.LUNAR_ROVER_WHEEL)
 #: ExoMars-like flexible wheel of seeds 000/001 (:data:`wheelsoil.parameters.exomars.EXOMARS_WHEEL`).
 EXOMARS = from_parameters(exomars.EXOMARS_WHEEL)
 
-PRESETS = {g.name: g for g in (LUNAR_ROVER, EXOMARS)}
+#: The CMU rig's K10-mini wheels, smooth and with 16 grousers of 5 mm (:data:`wheelsoil.parameters.cmu_k10.K10_MINI_WHEELS`:
+#: r = 0.058 m, b = 0.05 m; run rigid, as the rig's wheels are).
+CMU_K10_SMOOTH, CMU_K10_GROUSER = (from_parameters(cmu_k10.K10_MINI_WHEELS[k]) for k in ("smooth", "grouser"))
+
+PRESETS = {g.name: g for g in (LUNAR_ROVER, EXOMARS, CMU_K10_SMOOTH, CMU_K10_GROUSER)}
 
 
 def preset(name: str) -> WheelGeometry:
-    """A preset wheel by name (``lunar-rover`` or ``exomars``)."""
+    """A preset wheel by name (``lunar-rover``, ``exomars``, ``cmu-k10-smooth`` or ``cmu-k10-grouser``)."""
     try:
         return PRESETS[name]
     except KeyError:
