@@ -307,8 +307,8 @@ def summary_table(sweep: Sweep):
         row = {"case": c.name, "case_hash": c.folder.name}
         row.update({k: (_label(v) if isinstance(v, (list, tuple)) else v) for k, v in c.values.items()})
         wheel = build.wheel_geometry(c.case)
-        row.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "load_set": t.load,
-                    "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
+        row.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "slip_speed": t.slip_speed,
+                    "load_set": t.load, "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
                     "wheel_radius": wheel.radius, "wheel_width": wheel.width, "grouser_count": wheel.grouser_count,
                     "grouser_height": wheel.grouser_height if wheel.grouser_count else 0.0})
         row.update({k: v for k, v in r.summary_row().items() if k not in ("case", "case_hash")})

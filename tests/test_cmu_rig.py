@@ -66,3 +66,45 @@ def test_every_trial_is_a_case_whose_command_gives_its_rim_to_carriage_ratio(mea
 def test_conditions_outside_the_rigs_range_are_refused_at_their_key(override, key):
     with pytest.raises(CaseError, match=key.replace(".", r"\.")):
         load_case("cmu-grouser", [override])
+
+
+def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(measured_dir, tmp_path):
+    """The committed sweep presets are what the generator writes from the measured files; the full sweep has one
+    case per trial and the comparison (validate --model) pairs every measured trial, braking and dragged included,
+    with a case at its conditions."""
+    import numpy as np
+
+    from wheelsoil.cases.cmu_sweep import write_presets
+    from wheelsoil.cases.sweep import load_sweep
+    from wheelsoil.validation.compare import match_conditions
+    from wheelsoil.validation.measured import Measurements, load_cmu_trials
+
+    folder = Path(measured_dir) / "cmu_3d_terramechanics"
+    committed = Path(__file__).parents[1] / "cases" / "presets" / "sweeps"
+    for written in write_presets(folder, tmp_path):
+        assert written.read_text() == (committed / written.name).read_text(), written.name
+    full, part = load_sweep("cmu-trials"), load_sweep("cmu-trials-subset")
+    assert (len(full.cases), len(part.cases)) == (297, 25)
+    assert {c.case.case_hash() for c in part.cases} <= {c.case.case_hash() for c in full.cases}
+    # the repeats of a condition are replicas: other seeds
+    seeds = {}
+    for c in full.cases:
+        seeds.setdefault((c.case.wheel.preset, c.case.test.slip_angle, round(c.case.test.slip, 1)), set()).add(
+            c.case.case.seed)
+    assert max(len(s) for s in seeds.values()) >= 3
+
+    geometry = [specs(c.case)[1] for c in full.cases]
+    n = len(full.cases)
+    simulated = Measurements(
+        name="cmu-trials", slip=np.array([c.case.test.slip for c in full.cases]),
+        slip_angle=np.array([c.case.test.slip_angle for c in full.cases]),
+        load=np.array([c.case.test.load for c in full.cases]),
+        gravity=np.array([-c.case.soil.gravity_vector[2] for c in full.cases]),
+        radius=np.array([g.radius for g in geometry]), width=np.array([g.width for g in geometry]),
+        grouser_height=np.array([g.grouser_height if g.grouser_count else 0.0 for g in geometry]),
+        grouser_count=np.array([g.grouser_count for g in geometry], float), group=np.full(n, "1g"),
+        responses={q: np.full(n, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
+        std={}, notes="conditions only")
+    data = load_cmu_trials(folder, driving_only=False)
+    pairs, unmatched = match_conditions(data, simulated)
+    assert len(data) == 297 and unmatched.size == 0 and len(pairs) == 297

@@ -1,0 +1,101 @@
+"""The CMU trials as sweeps of the rig presets: one case per measured trial, at the trial's steering angle, slip and
+load, on the preset of its wheel (``cmu-grouser``'s base, with the smooth wheel where the trial's is), with the
+trial's repeat at its condition (wheel, steering angle, commanded rim speed; 1, 2, 3 in file order) as the bed's seed, so that the repeats of a condition are the simulation's replicas as they are the
+rig's.
+
+Written from the measured files (``../shared/data/measured/cmu_3d_terramechanics``) by::
+
+    python -m wheelsoil.cases.cmu_sweep ../shared/data/measured/cmu_3d_terramechanics
+
+into ``presets/sweeps/cmu-trials.toml`` (all 297 trials) and ``presets/sweeps/cmu-trials-subset.toml`` (the subset
+named by :data:`SUBSET`, fixed before any DEM--FEM result: the grouser wheel at 0, 45 and 90 deg and the smooth one
+at 0 and 90 deg, each at the dragged wheel, braking 0.5, free rolling, driving 0.5 and 0.9, first repeat: 25 cases
+spanning every response's range of steering and slip).
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+from wheelsoil.errors import WheelsoilInputError
+
+#: The files of the trials, one per wheel.
+TRIAL_FILES = {"smooth": "smooth_wheel_trials.csv", "grouser": "grouser_wheel_trials.csv"}
+#: The subset: wheel -> steering angles [deg]; the commanded slips (each trial nearest to one, within 0.05); repeat 1.
+SUBSET = {"grouser": (0.0, 45.0, 90.0), "smooth": (0.0, 90.0)}
+SUBSET_SLIPS = (-1.0, -0.5, 0.0, 0.5, 0.9)
+SUBSET_TRIAL = 1
+
+
+def trial_rows(folder: str | Path) -> list[dict]:
+    """One sweep row per measured trial: ``wheel.preset``, ``case.seed`` (the repeat at its condition), ``test.slip``,
+    ``test.slip_angle`` and ``test.load`` (the trial's measured mean load [N])."""
+    folder = Path(folder)
+    rows = []
+    for wheel, name in TRIAL_FILES.items():
+        path = folder / name
+        if not path.is_file():
+            raise WheelsoilInputError(f"{path} does not exist: the CMU trials are in "
+                                      "../shared/data/measured/cmu_3d_terramechanics")
+        repeats: dict[tuple, int] = {}
+        with open(path, newline="") as fh:
+            for row in csv.DictReader(fh):
+                # the files' 'trial' column is not the repeat (mostly 1): a condition is the wheel, steering angle
+                # and commanded rim speed, its repeats the rows in file order
+                condition = (float(row["steering_angle_deg"]), float(row["rim_speed_mm_s"]))
+                repeats[condition] = repeats.get(condition, 0) + 1
+                rows.append({"wheel.preset": f"cmu-k10-{wheel}", "case.seed": repeats[condition],
+                             "test.slip": float(row["slip"]), "test.slip_angle": float(row["steering_angle_deg"]),
+                             "test.load": float(row["vertical_load_N"])})
+    return rows
+
+
+def subset(rows: list[dict]) -> list[dict]:
+    """The rows of :data:`SUBSET`: per wheel, angle and commanded slip, the first repeat's trial."""
+    out = []
+    for wheel, angles in SUBSET.items():
+        for angle in angles:
+            for slip in SUBSET_SLIPS:
+                hits = [r for r in rows if r["wheel.preset"] == f"cmu-k10-{wheel}" and r["test.slip_angle"] == angle
+                        and abs(r["test.slip"] - slip) <= 0.05 and r["case.seed"] == SUBSET_TRIAL]
+                if len(hits) != 1:
+                    raise WheelsoilInputError(f"the subset's {wheel} wheel at {angle:g} deg, slip {slip:g}, repeat "
+                                              f"{SUBSET_TRIAL} matches {len(hits)} trials, not one")
+                out.extend(hits)
+    return out
+
+
+def sweep_toml(rows: list[dict], description: str) -> str:
+    """A sweep file on the ``cmu-grouser`` base with one ``[[sweep.rows]]`` table per row."""
+    lines = [f"# {line}" if line else "#" for line in description.splitlines()]
+    lines += ['[sweep]', 'base = "cmu-grouser"', '']
+    for r in rows:
+        lines.append("[[sweep.rows]]")
+        for key, value in r.items():
+            text = f'"{value}"' if isinstance(value, str) else repr(value)
+            lines.append(f'"{key}" = {text}')
+    return "\n".join(lines) + "\n"
+
+
+def write_presets(folder: str | Path, presets: str | Path | None = None) -> list[Path]:
+    """Write ``cmu-trials.toml`` and ``cmu-trials-subset.toml`` from the trials in ``folder``."""
+    presets = Path(presets) if presets is not None else Path(__file__).parent / "presets" / "sweeps"
+    rows = trial_rows(folder)
+    common = ("Written by `python -m wheelsoil.cases.cmu_sweep ../shared/data/measured/cmu_3d_terramechanics`\n"
+              "(wheelsoil.cases.cmu_sweep): one case per trial at its steering angle, slip and measured mean load;\n"
+              "its repeat at its condition is the bed's seed. Hours of CPU per case: use a GPU (wheelsoil batch --arch).")
+    paths = []
+    for name, chosen, what in (("cmu-trials", rows, f"The CMU single-wheel trials, all {len(rows)}, as DEM-FEM cases."),
+                               ("cmu-trials-subset", subset(rows), "A subset of the CMU trials fixed before any "
+                                "result (cases/cmu_sweep.py SUBSET): 25 cases.")):
+        path = presets / f"{name}.toml"
+        path.write_text(sweep_toml(chosen, f"{what}\n{common}"))
+        paths.append(path)
+    return paths
+
+
+if __name__ == "__main__":
+    for written in write_presets(sys.argv[1] if len(sys.argv) > 1 else "../shared/data/measured/cmu_3d_terramechanics"):
+        print(written)
