@@ -375,9 +375,9 @@ def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, le
 
 
 def _plot(study: ConvergenceStudy, rows: list[dict]) -> Path:
-    from .plots import _pyplot
+    from wheelsoil.plotting import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 3, figsize=(12, 6.5), sharey=True)
     pairs = [(f, lvs[k].scale, lvs[k + 1].scale) for f, lvs in study.levels.items() for k in range(len(lvs) - 1)]
     labels = [f"{f}\n{a:g}→{b:g}" for f, a, b in pairs]
