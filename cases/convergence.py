@@ -19,9 +19,15 @@ For every factor and each pair of neighbouring levels (coarse -> fine) and for e
 (:data:`QUANTITIES`) the report gives the change Delta = q_fine - q_coarse, its relative size
 Delta / max(|q_fine|, floor) (floors as the steady-state detector's: 5 % of W for forces, 5 % of W r for the
 torque, half a mean particle diameter for sinkage, 0.01 for slip) and its standard error
-sqrt(sem_fine^2 + sem_coarse^2) from the batch means over whole pitches of each run's steady window. A
-factor is converged at a level when every quantity changes by less than ``threshold`` (10 %) to the next
-finer level; a run that did not reach a steady state makes its changes unreportable, and the report says so.
+sqrt(sem_fine^2 + sem_coarse^2) from the batch means over whole pitches of each run's steady window; a run that
+did not reach a steady state makes its changes unreportable, and the report says so.
+
+"Converged" is the project's definition: for the factors refined towards zero (particle size, time step, mesh) the
+steady levels are extrapolated to scale 0 (:func:`extrapolation_rows`: a line in the scale weighted by each run's
+standard error, :mod:`wheelsoil.scale_extrapolation`), and the factor is converged when the reference's error
+against the extrapolated value, plus two standard errors, is within ``threshold`` (10 %) for every quantity: one
+refinement that moves little is not convergence. Depth and width (doubled, not refined) are converged from the
+level whose every quantity changes by less than the threshold to the next.
 
 The refined levels may drive up to twice the base case's ``test.drive_time`` (``--level-drive-time``): they
 stop once steady, like the reference, but a finer bed's quantities settle more slowly per simulated second.
@@ -289,12 +295,58 @@ def coarsest_converged(study: ConvergenceStudy, rows: list[dict]) -> dict:
     return verdict
 
 
+#: Factors refined towards zero (scale < 1), whose series is extrapolated to scale 0 (the reference is scale 1).
+REFINED_TOWARDS_ZERO = ("particle_size", "time_step", "mesh")
+
+
+def extrapolation_rows(study: ConvergenceStudy) -> list[dict]:
+    """Per refined factor and quantity: the steady levels' means against their scale extrapolated to scale 0
+    (:func:`wheelsoil.scale_extrapolation.extrapolate_to_zero_size`, weighted by each run's standard error, the
+    Birge ratio scaling them where the levels scatter beyond them), and the reference's error against it with its
+    standard error. Converged (the project's definition): that error plus two standard errors within the
+    threshold times max(|extrapolated|, floor). Needs two steady levels with finite errors; else ``reason``."""
+    from wheelsoil.errors import WheelsoilInputError as _Input
+    from wheelsoil.scale_extrapolation import extrapolate_to_zero_size
+
+    floors = _floors(study.base)
+    rows = []
+    for factor in REFINED_TOWARDS_ZERO:
+        levels = study.levels.get(factor, [])
+        if len(levels) < 2:
+            continue
+        values = [(lv.scale, _level_values(lv)) for lv in levels]
+        done = [(s, v) for s, v in values if v is not None]
+        steady = [(s, v) for s, v in done if v["steady"]]
+        for q in QUANTITIES:
+            row = {"factor": factor, "quantity": q, "levels": [s for s, _ in steady]}
+            if len(done) < len(values):
+                row["reason"] = f"{len(values) - len(done)} of {len(values)} levels have not run"
+            elif len(steady) < len(done):
+                row["reason"] = "not every level reached a steady state"
+            else:
+                try:
+                    fit = extrapolate_to_zero_size([s for s, _ in steady], [v[q][0] for _, v in steady],
+                                                   [v[q][1] for _, v in steady])
+                except _Input as exc:
+                    row["reason"] = str(exc)
+                else:
+                    ref = max(abs(fit.value), floors[q])
+                    error, error_se = fit.change(1.0)
+                    row.update(value=fit.value, value_se=fit.value_se, reference_error=error,
+                               reference_error_se=error_se, relative_error=error / ref,
+                               relative_error_se=error_se / ref, birge=fit.birge, dof=fit.dof,
+                               converged=bool(abs(error) + 2.0 * error_se <= study.threshold * ref))
+            rows.append(row)
+    return rows
+
+
 def write_report(study: ConvergenceStudy) -> list[Path]:
     """convergence.csv, convergence.json, convergence.md and convergence.png in the study folder."""
     import pandas as pd
 
     rows = comparison_rows(study)
     verdict = coarsest_converged(study, rows)
+    extrapolated = extrapolation_rows(study)
     study.out.mkdir(parents=True, exist_ok=True)
     table = pd.DataFrame(rows)
     written = []
@@ -305,16 +357,18 @@ def write_report(study: ConvergenceStudy) -> list[Path]:
                    "values": _level_values(lv)} for lv in lvs] for f, lvs in study.levels.items()}
     with atomic_output(study.out / "convergence.json") as tmp:
         tmp.write_text(json.dumps({"base": study.base.name, "threshold": study.threshold, "coarsest_converged": verdict,
-                                   "levels": levels, "comparisons": rows}, indent=2, default=float))
+                                   "levels": levels, "comparisons": rows, "extrapolated": extrapolated}, indent=2,
+                                  default=float))
     written.append(study.out / "convergence.json")
     with atomic_output(study.out / "convergence.md") as tmp:
-        tmp.write_text(report_markdown(study, rows, verdict, levels))
+        tmp.write_text(report_markdown(study, rows, verdict, levels, extrapolated))
     written.append(study.out / "convergence.md")
     written.append(_plot(study, rows))
     return written
 
 
-def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, levels: dict) -> str:
+def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, levels: dict,
+                    extrapolated: list[dict] | None = None) -> str:
     pct = int(round(100 * study.threshold))
     lines = [f"# Convergence study: {study.base.name}", "",
              f"Each factor's levels against the reference; a change is the finer level's mean minus the coarser's, "
@@ -353,11 +407,27 @@ def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, le
                     text = f"**{text}**"
                 cells.append(text)
             lines.append(f"| {factor} | {lvs[k].scale:g} → {lvs[k + 1].scale:g} | " + " | ".join(cells) + " |")
+    lines += _extrapolation_markdown(study, extrapolated or [])
     lines += ["", "## Verdict", ""]
     for factor, scale in verdict.items():
         mine = [r for r in rows if r["factor"] == factor]
         scales = ", ".join(f"{lv.scale:g}" for lv in study.levels[factor])
-        if scale is not None:
+        ext = [r for r in (extrapolated or []) if r["factor"] == factor]
+        neighbours = f" (neighbouring levels change by less than {pct} % from scale {scale:g} on)" if scale else ""
+        if ext and all("value" in r for r in ext):
+            bad = [QUANTITIES[r["quantity"]][0] for r in ext if not r["converged"]]
+            if bad:
+                lines.append(f"- {factor}: **not converged**: extrapolated to scale 0, the reference's error with two "
+                             f"standard errors exceeds {pct} % for {', '.join(bad)}{neighbours}.")
+            else:
+                lines.append(f"- {factor}: converged: extrapolated to scale 0, the reference's error with two standard "
+                             f"errors is within {pct} % for every quantity{neighbours}.")
+        elif scale is not None and factor in REFINED_TOWARDS_ZERO:
+            why = next((r["reason"] for r in ext if "reason" in r), "no extrapolation")
+            lines.append(f"- {factor}: **undecided**: neighbouring levels change by less than {pct} % from scale "
+                         f"{scale:g} on, but the series could not be extrapolated ({why}), and one refinement moving "
+                         "little is not convergence.")
+        elif scale is not None:
             lines.append(f"- {factor}: converged within {pct} % from scale {scale:g} on.")
         elif not all(r["finished"] for r in mine):
             lines.append(f"- {factor}: **undecided**: not every level ({scales}) has finished.")
@@ -372,6 +442,31 @@ def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, le
             lines.append(f"- {factor}: **not converged** within {pct} % over the levels run ({scales}); refine further.")
     lines.append("")
     return "\n".join(lines)
+
+
+def _extrapolation_markdown(study: ConvergenceStudy, extrapolated: list[dict]) -> list[str]:
+    """The extrapolated values and the reference's error against them, one line per refined factor."""
+    if not extrapolated:
+        return []
+    pct = int(round(100 * study.threshold))
+    lines = ["", "## Extrapolated to zero scale", "",
+             "Each refined factor's steady levels against their scale, a line weighted by the runs' standard errors "
+             "(scaled by the Birge ratio where the levels scatter beyond them), extrapolated to scale 0; below each "
+             f"value, the reference's error against it. Converged: that error plus two standard errors within {pct} %.",
+             "", "| factor | " + " | ".join(f"{v[0]} [{v[1]}]" for v in QUANTITIES.values()) + " |",
+             "|" + "---|" * (1 + len(QUANTITIES))]
+    for factor in dict.fromkeys(r["factor"] for r in extrapolated):
+        cells = []
+        for q, (_, _, scale) in QUANTITIES.items():
+            r = next(r for r in extrapolated if r["factor"] == factor and r["quantity"] == q)
+            if "value" not in r:
+                cells.append(r["reason"])
+                continue
+            text = (f"{scale * r['value']:.4g} ± {scale * r['value_se']:.2g}; reference "
+                    f"{100 * r['relative_error']:+.1f} ± {100 * r['relative_error_se']:.1f} %")
+            cells.append(text if r["converged"] else f"**{text}**")
+        lines.append(f"| {factor} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def _plot(study: ConvergenceStudy, rows: list[dict]) -> Path:

@@ -96,7 +96,9 @@ def test_changes_and_verdict(mini, tmp_path, monkeypatch):
     assert cv.coarsest_converged(tight, cv.comparison_rows(tight))["particle_size"] == 0.8
     paths = cv.write_report(tight)
     text = (tmp_path / "convergence.md").read_text()
-    assert "converged within 5 % from scale 0.8 on" in text and all(p.is_file() for p in paths)
+    # neighbouring levels within 5 % is not convergence: extrapolated, the reference is 0.2 / 1.2 off (see below)
+    assert "particle_size: **not converged**: extrapolated to scale 0" in text and all(p.is_file() for p in paths)
+    assert "(neighbouring levels change by less than 5 % from scale 0.8 on)" in text
     # a level that is not steady makes the verdict undecided, not "not converged"
     steady[0.64] = False
     cv.write_report(study)
@@ -135,3 +137,34 @@ def test_unrun_levels_are_reported_as_such(mini, tmp_path):
     assert cv.coarsest_converged(study, rows) == {"width": None}
     cv.write_report(study)
     assert "not run" in (tmp_path / "convergence.md").read_text()
+
+
+@pytest.mark.parametrize("slope, converged", [(0.25, False), (0.02, True)])
+def test_a_linear_series_extrapolates_to_its_intercept_and_the_verdict_follows_it(mini, tmp_path, monkeypatch,
+                                                                                 slope, converged):
+    """q(s) = q0 (1 + slope s), 1 % errors: the extrapolated value is q0, the reference's error slope q0 with the
+    propagated standard error; converged only when that error plus two standard errors is within 10 %."""
+    base = {"drawbar_pull": 500.0, "lateral_force": -200.0, "vertical_force": 3000.0, "torque": 600.0,
+            "sinkage": 0.08, "tread_slip": 0.3}
+
+    def values(lv):
+        out = {"steady": True, "wall_seconds": 1.0, "particles": 1, "dem_time_step": 1e-5}
+        for q, v in base.items():
+            m = v * (1 + slope * lv.scale)
+            out[q] = (m, 0.01 * abs(m))
+        return out
+
+    study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2)})
+    monkeypatch.setattr(cv, "_level_values", values)
+    rows = {r["quantity"]: r for r in cv.extrapolation_rows(study)}
+    assert set(rows) == set(cv.QUANTITIES) and all(r["factor"] == "particle_size" for r in rows.values())
+    r = rows["drawbar_pull"]
+    assert r["value"] == pytest.approx(500.0, rel=1e-9)
+    assert r["reference_error"] == pytest.approx(slope * 500.0, rel=1e-9)
+    assert r["birge"] == 1.0 and r["dof"] == 1 and r["reference_error_se"] > 0
+    assert all(x["converged"] is converged for x in rows.values())
+    cv.write_report(study)
+    text = (tmp_path / "convergence.md").read_text()
+    assert "## Extrapolated to zero scale" in text
+    assert ("particle_size: converged: extrapolated" in text) is converged
+    assert ("particle_size: **not converged**: extrapolated" in text) is not converged
