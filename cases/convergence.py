@@ -300,43 +300,52 @@ REFINED_TOWARDS_ZERO = ("particle_size", "time_step", "mesh")
 
 
 def extrapolation_rows(study: ConvergenceStudy) -> list[dict]:
-    """Per refined factor and quantity: the steady levels' means against their scale extrapolated to scale 0
-    (:func:`wheelsoil.scale_extrapolation.extrapolate_to_zero_size`, weighted by each run's standard error, the
-    Birge ratio scaling them where the levels scatter beyond them), and the reference's error against it with its
-    standard error. Converged (the project's definition): that error plus two standard errors within the
-    threshold times max(|extrapolated|, floor). Needs two steady levels with finite errors; else ``reason``."""
-    from wheelsoil.errors import WheelsoilInputError as _Input
-    from wheelsoil.scale_extrapolation import extrapolate_to_zero_size
-
+    """Per refined factor (:data:`REFINED_TOWARDS_ZERO`) and quantity, :func:`extrapolate_levels` of the study's
+    levels."""
     floors = _floors(study.base)
     rows = []
     for factor in REFINED_TOWARDS_ZERO:
         levels = study.levels.get(factor, [])
-        if len(levels) < 2:
-            continue
-        values = [(lv.scale, _level_values(lv)) for lv in levels]
-        done = [(s, v) for s, v in values if v is not None]
-        steady = [(s, v) for s, v in done if v["steady"]]
-        for q in QUANTITIES:
-            row = {"factor": factor, "quantity": q, "levels": [s for s, _ in steady]}
-            if len(done) < len(values):
-                row["reason"] = f"{len(values) - len(done)} of {len(values)} levels have not run"
-            elif len(steady) < len(done):
-                row["reason"] = "not every level reached a steady state"
+        if len(levels) >= 2:
+            rows += extrapolate_levels(factor, [(lv.scale, _level_values(lv)) for lv in levels], floors,
+                                       study.threshold)
+    return rows
+
+
+def extrapolate_levels(factor: str, levels: list[tuple[float, dict | None]], floors: dict,
+                       threshold: float) -> list[dict]:
+    """One row per quantity: the steady levels' means (``levels``: (scale, values) with values as a result's
+    summary gives them, ``None`` for a level not run) against their scale, extrapolated to scale 0
+    (:func:`wheelsoil.scale_extrapolation.extrapolate_to_zero_size`, weighted by each run's standard error, the
+    Birge ratio scaling them where the levels scatter beyond them), and the reference's (scale 1) error against
+    it with its standard error. Converged (the project's definition): that error plus two standard errors
+    within ``threshold`` times max(|extrapolated|, floor). Needs every level run and steady, with finite errors;
+    else the row says why (``reason``)."""
+    from wheelsoil.errors import WheelsoilInputError as _Input
+    from wheelsoil.scale_extrapolation import extrapolate_to_zero_size
+
+    done = [(s, v) for s, v in levels if v is not None]
+    steady = [(s, v) for s, v in done if v["steady"]]
+    rows = []
+    for q in QUANTITIES:
+        row = {"factor": factor, "quantity": q, "levels": [s for s, _ in steady]}
+        if len(done) < len(levels):
+            row["reason"] = f"{len(levels) - len(done)} of {len(levels)} levels have not run"
+        elif len(steady) < len(done):
+            row["reason"] = "not every level reached a steady state"
+        else:
+            try:
+                fit = extrapolate_to_zero_size([s for s, _ in steady], [v[q][0] for _, v in steady],
+                                               [v[q][1] for _, v in steady])
+            except _Input as exc:
+                row["reason"] = str(exc)
             else:
-                try:
-                    fit = extrapolate_to_zero_size([s for s, _ in steady], [v[q][0] for _, v in steady],
-                                                   [v[q][1] for _, v in steady])
-                except _Input as exc:
-                    row["reason"] = str(exc)
-                else:
-                    ref = max(abs(fit.value), floors[q])
-                    error, error_se = fit.change(1.0)
-                    row.update(value=fit.value, value_se=fit.value_se, reference_error=error,
-                               reference_error_se=error_se, relative_error=error / ref,
-                               relative_error_se=error_se / ref, birge=fit.birge, dof=fit.dof,
-                               converged=bool(abs(error) + 2.0 * error_se <= study.threshold * ref))
-            rows.append(row)
+                ref = max(abs(fit.value), floors[q])
+                error, error_se = fit.change(1.0)
+                row.update(value=fit.value, value_se=fit.value_se, reference_error=error, reference_error_se=error_se,
+                           relative_error=error / ref, relative_error_se=error_se / ref, birge=fit.birge, dof=fit.dof,
+                           converged=bool(abs(error) + 2.0 * error_se <= threshold * ref))
+        rows.append(row)
     return rows
 
 
