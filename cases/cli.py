@@ -200,8 +200,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "element size x 1, 0.5 by default), as a sweep in --out (finished cases are kept), "
                                    "and write convergence.md, convergence.csv, convergence.json and convergence.png: "
                                    "every reported quantity's change between neighbouring levels with its standard "
-                                   "error, and the coarsest scale of each factor at which all change by less than "
-                                   "--threshold (cases/convergence.py documents the method).")
+                                   "error; particle size, DEM step and mesh extrapolated to scale 0, converged where "
+                                   "the reference's error against that, plus two standard errors, is within "
+                                   "--threshold; depth and width converged from the level whose doubling changes "
+                                   "every quantity by less than it (cases/convergence.py documents the method).")
     p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name")
     _add_set_option(p)
     for factor, levels in (("particle-size", "1,0.8,0.64"), ("depth", "1,2"), ("width", "1,2"),
@@ -220,6 +222,10 @@ def build_parser() -> argparse.ArgumentParser:
                                                           "cores of a small machine)")
     p.add_argument("--timeout", type=float, default=None, help="give up a case after this many seconds")
     p.add_argument("--report-only", action="store_true", help="only rewrite the report from the finished cases")
+    p.add_argument("--particle-step", choices=("common", "own"), default="common",
+                   help="DEM step of the particle-size levels: 'common' (default), all at the finest level's, so the "
+                        "series changes the particles alone; 'own', each at its own stable step (studies before "
+                        "2026-11-26)")
     p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
     p.set_defaults(func=cmd_convergence)
 
@@ -526,13 +532,15 @@ def cmd_convergence(args) -> int:
     out = args.out or Path("wheelsoil-output") / "convergence" / case.name
     if args.level_drive_time is not None and not args.level_drive_time > 0:
         raise _InputError(f"--level-drive-time {args.level_drive_time} must be > 0 seconds")
-    study = make_study(case, out, levels, args.threshold, level_drive_time=args.level_drive_time)
+    study = make_study(case, out, levels, args.threshold, level_drive_time=args.level_drive_time,
+                       particle_step=args.particle_step)
     if args.report_only:
         paths = write_report(study)
     else:
         resolve_time_step_levels(study)  # with the others when the reference has already run
         console.print(f"convergence study of {case.name}: {len(study.cases())} cases "
-                      f"(+ {sum(lv.case is None for lvs in study.levels.values() for lv in lvs)} time-step levels after the reference) "
+                      f"(+ {sum(lv.case is None for lvs in study.levels.values() for lv in lvs)} levels that need "
+                      "the reference's DEM step, after it) "
                       f"in {out}; estimated soil cost per simulated second against the reference:")
         for row in plan(study):
             console.print(f"  {row['factor']:>13s} x {row['scale']:<5g} ~{row['particles']:>9,} particles, "

@@ -8,7 +8,8 @@ finished cases skipped when the study runs again), and writes a report:
 ======================  ===============================================================  =================
 factor                  what changes (``scale`` multiplies the reference value)          default levels
 ======================  ===============================================================  =================
-``particle_size``       ``soil.diameter_min`` and ``soil.diameter_max`` (finer: < 1)     1, 0.8, 0.64
+``particle_size``       ``soil.diameter_min`` and ``soil.diameter_max`` (finer: < 1),    1, 0.8, 0.64
+                        every level at one DEM step (the finest level's: see below)
 ``depth``               ``soil.depth``                                                   1, 2
 ``width``               ``soil.width``                                                   1, 2
 ``time_step``           ``soil.time_step`` (of the reference run: the same bed)          1, 0.5
@@ -33,7 +34,12 @@ The refined levels may drive up to twice the base case's ``test.drive_time`` (``
 stop once steady, like the reference, but a finer bed's quantities settle more slowly per simulated second.
 
 The time-step level runs after the reference, at ``scale`` times the DEM step the reference used (read from
-its result); the bed is prepared with its own stable step either way (:class:`~wheelsoil.coupling.testbed.
+its result); the bed is prepared with its own stable step either way. So do the particle-size levels
+(``particle_step="common"``, the default): every one of them, the reference's particle size included (a case of
+its own), runs at the reference's DEM step times the finest particle scale, the stable step of the finest level,
+so that the particle-size series changes the particles and not the step with them (the stable step is
+proportional to the particle size; ``particle_step="own"``: each level at its own stable step, as studies before
+2026-11-26 ran) (:class:`~wheelsoil.coupling.testbed.
 TestbedSpec` ``time_step``), so the level tests the step and not a new bed.
 """
 
@@ -41,7 +47,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
@@ -86,6 +92,10 @@ class Level:
     folder: Path | None = None
 
 
+#: How the particle-size levels choose their DEM step.
+PARTICLE_STEPS = ("common", "own")
+
+
 @dataclass
 class ConvergenceStudy:
     base: CaseFile
@@ -94,6 +104,7 @@ class ConvergenceStudy:
     threshold: float = 0.10
     reference: Level | None = field(default=None)
     level_drive_time: float | None = None
+    particle_step: str = "common"
 
     def cases(self) -> list[Level]:
         """The distinct levels (the reference once)."""
@@ -113,10 +124,18 @@ def plan(study: ConvergenceStudy) -> list[dict]:
     ref = build.bed_spec(study.base)
     n_ref = estimated_particles(ref)
     out = []
+    finest = min(lv.scale for lv in study.levels.get("particle_size", [])) if "particle_size" in study.levels else 1
     for lv in study.cases() + [lv for lvs in study.levels.values() for lv in lvs if lv.case is None]:
         spec = build.bed_spec(lv.case or study.base)
+        if lv.factor == "particle_size":
+            spec = replace(ref, diameter_min=ref.diameter_min * lv.scale, diameter_max=ref.diameter_max * lv.scale)
         n = estimated_particles(spec)
-        steps = ref.diameter_min / spec.diameter_min / (lv.scale if lv.factor == "time_step" else 1.0)
+        if lv.factor == "time_step":
+            steps = 1.0 / lv.scale
+        elif lv.factor == "particle_size" and study.particle_step == "common":
+            steps = 1.0 / finest
+        else:
+            steps = ref.diameter_min / spec.diameter_min
         out.append({"factor": lv.factor, "scale": lv.scale, "particles": int(round(n)),
                     "relative_soil_cost": n / n_ref * steps,
                     "drive_time": study.base.test.drive_time if lv.scale == 1.0 else study.level_drive_time})
@@ -135,11 +154,19 @@ def _check_levels(factor: str, scales) -> tuple[float, ...]:
     return scales
 
 
-def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_step: float | None = None) -> dict:
-    """The case keys that make ``factor`` at ``scale`` times the reference value."""
+def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_step: float | None = None,
+                    common_step_scale: float | None = None) -> dict | None:
+    """The case keys that make ``factor`` at ``scale`` times the reference value; None while they need the
+    reference's DEM step and it is not known. ``common_step_scale``: the particle-size levels all run at the
+    reference's step times this (the finest particle scale); None: each at its own stable step."""
     s, w = case.soil, case.wheel
     if factor == "particle_size":
-        return {"soil.diameter_min": s.diameter_min * scale, "soil.diameter_max": s.diameter_max * scale}
+        sizes = {"soil.diameter_min": s.diameter_min * scale, "soil.diameter_max": s.diameter_max * scale}
+        if common_step_scale is None:
+            return sizes
+        if reference_time_step is None:
+            return None  # known once the reference has run
+        return {**sizes, "soil.time_step": reference_time_step * common_step_scale}
     if factor == "depth":
         return {"soil.depth": s.depth * scale}
     if factor == "width":
@@ -157,14 +184,18 @@ def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_st
 
 
 def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, threshold: float = 0.10,
-               reference_time_step: float | None = None, level_drive_time: float | None = None) -> ConvergenceStudy:
+               reference_time_step: float | None = None, level_drive_time: float | None = None,
+               particle_step: str = "common") -> ConvergenceStudy:
     """The study's cases, each validated before anything runs (errors name the factor, level and key).
 
     level_drive_time: the longest drive of the refined levels [s] (default: twice the base case's
     ``test.drive_time`` when the base stops once steady, else the base's). A finer or larger bed is noisier
     per pitch or slower to settle; a run stops once it is steady, so the longer limit changes nothing for a
-    level that would have been steady within the base's, and the reference keeps the base case unchanged."""
+    level that would have been steady within the base's, and the reference keeps the base case unchanged.
+    particle_step: ``"common"`` or ``"own"`` (see the module docstring)."""
     out = Path(out)
+    if particle_step not in PARTICLE_STEPS:
+        raise WheelsoilInputError(f"particle_step = {particle_step!r}: choose {' or '.join(PARTICLE_STEPS)}")
     levels = {k: _check_levels(k, v) for k, v in (levels or DEFAULT_LEVELS).items()}
     if not 0 < threshold < 1:
         raise WheelsoilInputError(f"threshold = {threshold!r} must lie in (0, 1)")
@@ -174,24 +205,35 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
         raise WheelsoilInputError(f"level drive time = {level_drive_time!r} s must be at least the case's "
                                   f"test.drive_time = {base.test.drive_time} s")
     base_data = base.model_dump(mode="json")
-    study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold, level_drive_time=level_drive_time)
-    if reference_time_step is None and "time_step" in levels and base.soil.time_step is not None:
+    study = ConvergenceStudy(base=base, out=out, levels={}, threshold=threshold, level_drive_time=level_drive_time,
+                             particle_step=particle_step)
+    if reference_time_step is None and base.soil.time_step is not None:
         reference_time_step = base.soil.time_step
+    common = min(levels["particle_size"]) if particle_step == "common" and "particle_size" in levels else None
+    reference_data = dict(base_data, case=dict(base_data["case"], name=f"{base.name}-reference"))
+    reference_case = validate_case(reference_data, "convergence study, reference")
+    reference_hash = reference_case.case_hash()
     for factor, scales in levels.items():
         study.levels[factor] = []
         for scale in scales:
-            over = level_overrides(base, factor, scale, reference_time_step)
+            over = level_overrides(base, factor, scale, reference_time_step,
+                                   common if factor == "particle_size" else None)
             lv = Level(factor, scale, over or {})
             if over is not None:
                 extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
                 data = apply_overrides(base_data, [(k.split("."), v) for k, v in {**over, **extra}.items()])
-                label = "reference" if scale == 1.0 else f"{factor}x{scale:g}"
-                data["case"]["name"] = f"{base.name}-{label}"
-                lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")
+                case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")
+                if case.case_hash() == reference_hash:
+                    lv.case = reference_case  # every factor's scale 1 that changes nothing is the base case itself
+                    study.reference = lv
+                else:
+                    data["case"]["name"] = f"{base.name}-{factor}x{scale:g}" + (
+                        "-common-step" if factor == "particle_size" and scale == 1.0 else "")
+                    lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over})")
                 lv.folder = out / "cases" / lv.case.case_hash()
             study.levels[factor].append(lv)
-            if scale == 1.0 and lv.case is not None:
-                study.reference = lv  # every factor's scale 1 is the base case itself
+    if study.reference is None:  # no factor's scale 1 is the base case: the reference runs on its own
+        study.reference = Level("reference", 1.0, {}, reference_case, out / "cases" / reference_hash)
     return study
 
 
@@ -202,9 +244,14 @@ def _sweep_of(study: ConvergenceStudy, levels: list[Level]) -> Sweep:
                  swept_keys=["factor", "scale"])
 
 
+def _unresolved(study: ConvergenceStudy) -> bool:
+    return any(lv.case is None for lvs in study.levels.values() for lv in lvs)
+
+
 def resolve_time_step_levels(study: ConvergenceStudy) -> bool:
-    """Make the time-step levels' cases from the finished reference's DEM step; False while it has not run."""
-    if not any(lv.case is None for lv in study.levels.get("time_step", [])):
+    """Make the levels that need the reference's DEM step (the time-step levels, and the particle-size levels at
+    a common step) from the finished reference's; False while it has not run."""
+    if not _unresolved(study):
         return True
     ref = study.reference
     if ref is None or not (ref.folder / RESULT_NAME).is_file():
@@ -212,7 +259,7 @@ def resolve_time_step_levels(study: ConvergenceStudy) -> bool:
     dt = float(load_result(ref.folder / RESULT_NAME).info["dem_time_step"])
     levels = {k: [lv.scale for lv in v] for k, v in study.levels.items()}
     study.levels = make_study(study.base, study.out, levels, study.threshold, reference_time_step=dt,
-                              level_drive_time=study.level_drive_time).levels
+                              level_drive_time=study.level_drive_time, particle_step=study.particle_step).levels
     return True
 
 
@@ -221,12 +268,13 @@ def run_study(study: ConvergenceStudy, *, workers: int = 1, arch: str | None = N
     """Run every level (the time-step level after the reference, or with the others when the reference has
     finished before) and write the report; returns the statuses."""
     resolve_time_step_levels(study)
-    status = run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
+    first = study.cases() if study.reference in study.cases() else [study.reference] + study.cases()
+    status = run_sweep(_sweep_of(study, first), workers=workers, arch=arch, timeout=timeout,
                        progress=progress, console=console)
-    if any(lv.case is None for lv in study.levels.get("time_step", [])):
+    if _unresolved(study):
         if not resolve_time_step_levels(study):
-            raise WheelsoilInputError("the time-step levels need the reference run's DEM step; the reference failed "
-                                      f"(see {study.out / 'status.json'})")
+            raise WheelsoilInputError("the time-step and common-step particle levels need the reference run's DEM "
+                                      f"step; the reference failed (see {study.out / 'status.json'})")
         status.update(run_sweep(_sweep_of(study, study.cases()), workers=workers, arch=arch, timeout=timeout,
                                 progress=progress, console=console))
     write_report(study)

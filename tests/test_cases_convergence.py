@@ -19,7 +19,7 @@ def mini():
 
 def test_levels_change_only_their_keys(mini, tmp_path):
     study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2), "mesh": (1, 0.5),
-                                           "time_step": (1, 0.5)})
+                                           "time_step": (1, 0.5)}, particle_step="own")
     ref = study.reference.case
     ps = study.levels["particle_size"][2].case
     assert ps.soil.diameter_min == pytest.approx(0.64 * ref.soil.diameter_min)
@@ -39,6 +39,32 @@ def test_levels_change_only_their_keys(mini, tmp_path):
     again = cv.make_study(mini, tmp_path, {"time_step": (1, 0.5)}, reference_time_step=2e-5)
     assert again.levels["time_step"][1].case.soil.time_step == pytest.approx(1e-5)
     assert build.bed_spec(again.levels["time_step"][1].case) == build.bed_spec(again.reference.case)  # the same bed
+
+
+def test_particle_levels_share_the_finest_levels_dem_step(mini, tmp_path):
+    """By default every particle-size level, the reference's size included (a case of its own), runs at the
+    reference's DEM step times the finest scale, so the series changes the particles and not the step; the
+    levels wait for the reference's step like the time-step levels."""
+    levels = {"particle_size": (1, 0.8, 0.64), "depth": (1, 2)}
+    waiting = cv.make_study(mini, tmp_path, levels)
+    assert all(lv.case is None for lv in waiting.levels["particle_size"])
+    assert waiting.reference.case.soil.time_step is None and waiting.reference is waiting.levels["depth"][0]
+    study = cv.make_study(mini, tmp_path, levels, reference_time_step=2e-5)
+    ps = study.levels["particle_size"]
+    assert [lv.case.soil.time_step for lv in ps] == [pytest.approx(0.64 * 2e-5)] * 3
+    assert ps[0].case.soil.diameter_min == mini.soil.diameter_min and ps[0].folder != study.reference.folder
+    assert ps[2].case.soil.diameter_min == pytest.approx(0.64 * mini.soil.diameter_min)
+    assert build.bed_spec(ps[0].case) == build.bed_spec(study.reference.case)  # the reference's bed, a finer step
+    assert len(study.cases()) == 1 + 3 + 1
+    # the plan: each particle level's cost at the common step, 1 / 0.64 steps per simulated second
+    rows = {(r["factor"], r["scale"]): r for r in cv.plan(study)}
+    assert rows["particle_size", 1.0]["relative_soil_cost"] == pytest.approx(1 / 0.64, rel=1e-3)
+    assert rows["particle_size", 0.64]["relative_soil_cost"] == pytest.approx(0.64 ** -3 / 0.64, rel=1e-2)
+    # a case without time-step or depth factor: the reference runs on its own
+    alone = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.5)}, reference_time_step=2e-5)
+    assert alone.reference.factor == "reference" and alone.reference.case.soil.time_step is None
+    with pytest.raises(WheelsoilInputError, match="particle_step = 'shared'"):
+        cv.make_study(mini, tmp_path, levels, particle_step="shared")
 
 
 @pytest.mark.parametrize("levels, message", [
