@@ -193,6 +193,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--arch", default=None, help="Taichi backend of every case: cpu (default), cuda, ...")
     p.set_defaults(func=cmd_batch)
 
+    p = sub.add_parser("replicate", help="run a case on beds of other particle seeds: the run-to-run spread against "
+                                         "the runs' own error bars",
+                       description="Run CASE once per --seeds value (a sweep over case.seed in --out: finished replicas "
+                                   "are kept) and write replicas.md and replicas.json: per reported quantity the "
+                                   "replicas' mean and standard deviation, the runs' own standard errors, the inflation "
+                                   "factor (spread over own error, with its 95 %% interval) and how many runs' 95 %% "
+                                   "intervals hold the other replicas' mean (cases/replicas.py documents the method).")
+    p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name")
+    _add_set_option(p)
+    p.add_argument("--seeds", nargs="+", required=True, help="particle seeds, at least two (e.g. 0 1 2 3 4)")
+    p.add_argument("--out", type=Path, default=None, help="replica folder (default wheelsoil-output/replicas/<case>)")
+    p.add_argument("--workers", type=int, default=1, help="replicas run at once (default 1)")
+    p.add_argument("--timeout", type=float, default=None, help="give up a replica after this many seconds")
+    p.add_argument("--report-only", action="store_true", help="only rewrite the report from the finished replicas")
+    p.add_argument("--arch", default=None, help="Taichi backend of every replica: cpu (default), cuda, ...")
+    p.set_defaults(func=cmd_replicate)
+
     p = sub.add_parser("convergence", help="convergence study of a case: particle size, bed depth and width, time "
                                            "step, wheel mesh; report of the changes",
                        description="Run a case at its reference scale and at refined levels of each factor "
@@ -511,6 +528,28 @@ def cmd_batch(args) -> int:
     for key, v in failed.items():
         console.print(f"  [red]failed[/] {key}: {v.get('error')} (log: {sweep.out / 'cases' / key / 'run.log'})")
     return EXIT_SWEEP_FAILED if failed else EXIT_OK
+
+
+def cmd_replicate(args) -> int:
+    from .replicas import make_replicas, write_report
+    from .schema import load_case
+    from .sweep import run_sweep
+
+    console = _console()
+    case = load_case(args.case, list(args.set or []))
+    if args.workers < 1:
+        raise _InputError(f"--workers {args.workers} must be >= 1")
+    if args.timeout is not None and not args.timeout > 0:
+        raise _InputError(f"--timeout {args.timeout} must be > 0 seconds")
+    out = args.out or Path("wheelsoil-output") / "replicas" / case.name
+    sweep = make_replicas(case, args.seeds, out)
+    if not args.report_only:
+        run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
+                  console=console)
+    paths = write_report(sweep, case)
+    console.print(paths[1].read_text())
+    console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")
+    return EXIT_OK
 
 
 def cmd_convergence(args) -> int:

@@ -1,0 +1,132 @@
+"""Replicas: one case run on beds of other particle seeds, and how far its own error bars can be trusted.
+
+A run's summary gives each steady mean a standard error from its batch means (one per pitch of the tread). That
+error sees the noise within the run's window, not the run-to-run spread of packings, and batch means that are
+correlated over longer than a pitch make it too small. ``wheelsoil replicate CASE --seeds 0 1 2 3 4`` runs the case
+on one bed per seed (a sweep over ``case.seed``: finished replicas are kept) and writes ``replicas.md`` and
+``replicas.json``: for every reported quantity
+
+* the replicas' mean and their standard deviation s (ddof 1) -- the run-to-run spread;
+* the root mean square of the runs' own standard errors, and the **inflation factor** s / rms(sem) with its 95 %
+  interval from the chi-square distribution of s^2 (n - 1 degrees of freedom): a factor above 1 beyond its
+  interval says the runs' error bars are too small by that much;
+* the **coverage**: how many runs' own 95 % intervals (``ci95``, Student's t) hold the mean of the other replicas,
+  with the interval widened by sqrt(1 + 1 / (n - 1)) for that mean's own scatter; an honest interval holds it in
+  about 95 % of runs.
+
+Only steady runs count; runs that are not steady are listed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import chi2
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.provenance import atomic_output
+
+from .convergence import QUANTITIES
+from .run import RESULT_NAME
+from .schema import CaseFile, apply_overrides, validate_case
+from .sweep import Sweep, SweepCase
+
+def check_seeds(seeds) -> tuple[int, ...]:
+    """At least two distinct non-negative integer seeds."""
+    try:
+        out = tuple(int(s) for s in seeds)
+    except (TypeError, ValueError):
+        raise WheelsoilInputError(f"--seeds {seeds!r}: give integers (e.g. --seeds 0 1 2 3 4)") from None
+    if len(out) < 2 or len(set(out)) != len(out) or min(out) < 0 or any(int(s) != float(s) for s in seeds):
+        raise WheelsoilInputError(f"--seeds {list(seeds)}: give at least two distinct integers >= 0 (a spread "
+                                  "between runs needs two runs)")
+    return out
+
+
+def make_replicas(base: CaseFile, seeds, out: str | Path) -> Sweep:
+    """The sweep of the base case over ``case.seed`` (every replica validated before anything runs)."""
+    seeds = check_seeds(seeds)
+    out = Path(out)
+    data = base.model_dump(mode="json")
+    cases = []
+    for seed in seeds:
+        d = apply_overrides(data, [(["case", "seed"], seed)])
+        d["case"]["name"] = f"{base.name}-seed{seed}"
+        case = validate_case(d, f"replica of {base.name}, seed {seed}")
+        cases.append(SweepCase(values={"case.seed": seed}, case=case, folder=out / "cases" / case.case_hash()))
+    return Sweep(name=f"replicas-{base.name}", cases=cases, out=out, swept_keys=["case.seed"])
+
+
+def _summaries(sweep: Sweep) -> list[tuple[int, dict | None]]:
+    from .results import load_result
+
+    out = []
+    for c in sweep.cases:
+        path = c.folder / RESULT_NAME
+        out.append((c.values["case.seed"], load_result(path).summary if path.is_file() else None))
+    return out
+
+
+def replica_statistics(summaries: list[tuple[int, dict | None]]) -> dict:
+    """The replicas' statistics (see the module docstring) from (seed, summary or None) pairs."""
+    done = [(s, m) for s, m in summaries if m is not None]
+    steady = [(s, m) for s, m in done if m["steady"]]
+    result = {"seeds": [s for s, _ in summaries], "finished": [s for s, _ in done],
+              "steady": [s for s, _ in steady], "quantities": {}}
+    n = len(steady)
+    for q in QUANTITIES:
+        x = np.array([m[q]["mean"] for _, m in steady], float)
+        sem = np.array([m[q]["sem"] for _, m in steady], float)
+        ci = np.array([m[q].get("ci95", math.nan) for _, m in steady], float)
+        row = {"n": n, "values": x.tolist(), "sems": sem.tolist()}
+        if n >= 2:
+            sd = float(np.std(x, ddof=1))
+            rms = float(np.sqrt(np.mean(sem ** 2))) if np.all(np.isfinite(sem)) else math.nan
+            lo, hi = chi2.ppf(0.975, n - 1), chi2.ppf(0.025, n - 1)
+            row.update(mean=float(x.mean()), spread=sd, rms_sem=rms,
+                       inflation=sd / rms if rms > 0 else math.nan,
+                       inflation_interval=[sd * math.sqrt((n - 1) / lo) / rms, sd * math.sqrt((n - 1) / hi) / rms]
+                       if rms > 0 else [math.nan, math.nan])
+            others = np.array([(x.sum() - x[k]) / (n - 1) for k in range(n)])
+            held = np.abs(x - others) <= ci * math.sqrt(1.0 + 1.0 / (n - 1))
+            known = np.isfinite(ci)
+            row.update(covered=int(np.sum(held & known)), coverage_runs=int(known.sum()))
+        result["quantities"][q] = row
+    return result
+
+
+def write_report(sweep: Sweep, base: CaseFile) -> list[Path]:
+    """replicas.json and replicas.md in the sweep folder."""
+    stats = replica_statistics(_summaries(sweep))
+    sweep.out.mkdir(parents=True, exist_ok=True)
+    with atomic_output(sweep.out / "replicas.json") as tmp:
+        tmp.write_text(json.dumps({"case": base.name, **stats}, indent=2, default=float))
+    with atomic_output(sweep.out / "replicas.md") as tmp:
+        tmp.write_text(report_markdown(base.name, stats))
+    return [sweep.out / "replicas.json", sweep.out / "replicas.md"]
+
+
+def report_markdown(name: str, stats: dict) -> str:
+    seeds, steady = stats["seeds"], stats["steady"]
+    unsteady = sorted(set(stats["finished"]) - set(steady))
+    lines = [f"# Replicas of {name}", "",
+             f"Seeds {', '.join(map(str, seeds))}: {len(stats['finished'])} finished, {len(steady)} steady"
+             + (f" (not steady, left out: {', '.join(map(str, unsteady))})" if unsteady else "") + ".", "",
+             "Spread: the replicas' standard deviation (run to run). Own error: the root mean square of the runs' "
+             "standard errors. Inflation: spread / own error with its 95 % interval (chi-square); above 1 the runs' "
+             "error bars are too small. Coverage: runs whose own 95 % interval (widened by sqrt(1 + 1/(n-1))) holds "
+             "the mean of the other replicas.", "",
+             "| quantity | mean | spread | own error | inflation | coverage |", "|---|---|---|---|---|---|"]
+    for q, (label, unit, scale) in QUANTITIES.items():
+        r = stats["quantities"][q]
+        if r["n"] < 2:
+            lines.append(f"| {label} [{unit}] | fewer than two steady replicas | | | | |")
+            continue
+        lo, hi = r["inflation_interval"]
+        lines.append(f"| {label} [{unit}] | {scale * r['mean']:.4g} | {scale * r['spread']:.2g} | "
+                     f"{scale * r['rms_sem']:.2g} | {r['inflation']:.2f} ({lo:.2f}–{hi:.2f}) | "
+                     f"{r['covered']} of {r['coverage_runs']} |")
+    return "\n".join(lines) + "\n"
