@@ -553,8 +553,8 @@ def cmd_replicate(args) -> int:
 
 
 def cmd_convergence(args) -> int:
-    from .convergence import (DEFAULT_LEVELS, make_study, parse_levels, plan, resolve_time_step_levels,
-                              run_study, write_report)
+    from .convergence import DEFAULT_LEVELS, make_study, parse_levels, plan, resolve_time_step_levels, run_study
+    from .convergence_report import write_report
     from .schema import load_case
 
     console = _console()
@@ -586,6 +586,7 @@ def cmd_convergence(args) -> int:
                           f"soil cost x {row['relative_soil_cost']:.2g}, drive up to {row['drive_time']:g} s")
         run_study(study, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
+        write_report(study)
         paths = [out / n for n in ("convergence.md", "convergence.csv", "convergence.json", "convergence.png")]
     console.print((out / "convergence.md").read_text() if (out / "convergence.md").is_file() else "")
     console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")

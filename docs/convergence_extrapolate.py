@@ -1,5 +1,5 @@
 """A stored convergence study (its ``convergence.json``) asked again with the extrapolated definition of
-"converged" (:func:`wheelsoil.cases.convergence.extrapolate_levels`): particle size, DEM step and wheel mesh
+"converged" (:func:`wheelsoil.cases.convergence_report.extrapolate_levels`): particle size, DEM step and wheel mesh
 extrapolated to scale 0 from the levels' stored means and standard errors, no run needed.
 
 Usage (from the repository root)::
@@ -20,6 +20,7 @@ import sys
 
 def main(argv=None) -> int:
     from wheelsoil.cases import convergence as cv
+    from wheelsoil.cases import convergence_report as report
     from wheelsoil.cases.schema import load_case
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -28,18 +29,18 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     study = json.loads(open(args.study_json).read())
     case = load_case(args.case or study["base"])
-    floors = cv._floors(case)
+    floors = report.relative_floors(case)
     threshold = float(study["threshold"])
     print(f"| factor | levels | quantity | extrapolated | reference | reference's error | converged "
           f"({100 * threshold:.0f} %, 2 SE) |")
     print("|---|---|---|---|---|---|---|")
-    for factor in cv.REFINED_TOWARDS_ZERO:
+    for factor in report.REFINED_TOWARDS_ZERO:
         levels = study["levels"].get(factor)
         if not levels or len(levels) < 2:
             continue
         pairs = [(lv["scale"], None if lv["values"] is None else
                   {**lv["values"], **{q: tuple(lv["values"][q]) for q in cv.QUANTITIES}}) for lv in levels]
-        for row in cv.extrapolate_levels(factor, pairs, floors, threshold):
+        for row in report.extrapolate_levels(factor, pairs, floors, threshold):
             label, unit, scale = cv.QUANTITIES[row["quantity"]]
             scales = ", ".join(f"{s:g}" for s, _ in pairs)
             if "value" not in row:

@@ -8,6 +8,7 @@ import pytest
 
 from wheelsoil.cases import build
 from wheelsoil.cases import convergence as cv
+from wheelsoil.cases import convergence_report as cr
 from wheelsoil.cases.schema import load_case
 from wheelsoil.errors import WheelsoilInputError
 
@@ -100,10 +101,10 @@ def _values(scale, steady=True):
 def test_changes_and_verdict(mini, tmp_path, monkeypatch):
     study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2)})
     steady = {0.64: False}
-    monkeypatch.setattr(cv, "_level_values",
+    monkeypatch.setattr(cr, "_level_values",
                         lambda lv: _values(lv.scale if lv.factor == "particle_size" else 0.1,
                                            steady=steady.get(lv.scale, True)))
-    rows = cv.comparison_rows(study)
+    rows = cr.comparison_rows(study)
     r = next(r for r in rows if r["factor"] == "particle_size" and r["coarse_scale"] == 1.0
              and r["quantity"] == "drawbar_pull")
     coarse, fine = 500 * 1.2, 500 * (1 + 0.2 * 0.64)
@@ -112,22 +113,22 @@ def test_changes_and_verdict(mini, tmp_path, monkeypatch):
     assert r["change_sem"] == pytest.approx(math.hypot(0.01 * coarse, 0.01 * fine))
     # 1 -> 0.8: -6.4 % (converged); 0.8 -> 0.64 not steady, so not converged: no coarsest level
     assert r["converged"]
-    verdict = cv.coarsest_converged(study, rows)
+    verdict = cr.coarsest_converged(study, rows)
     assert verdict["particle_size"] is None
     assert verdict["depth"] == 1.0
     steady.clear()
-    assert cv.coarsest_converged(study, cv.comparison_rows(study))["particle_size"] == 1.0
+    assert cr.coarsest_converged(study, cr.comparison_rows(study))["particle_size"] == 1.0
     tight = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64)}, threshold=0.05)
     # 1 -> 0.8 changes 6.4 %, 0.8 -> 0.64 4.4 %: converged within 5 % only from 0.8 on
-    assert cv.coarsest_converged(tight, cv.comparison_rows(tight))["particle_size"] == 0.8
-    paths = cv.write_report(tight)
+    assert cr.coarsest_converged(tight, cr.comparison_rows(tight))["particle_size"] == 0.8
+    paths = cr.write_report(tight)
     text = (tmp_path / "convergence.md").read_text()
     # neighbouring levels within 5 % is not convergence: extrapolated, the reference is 0.2 / 1.2 off (see below)
     assert "particle_size: **not converged**: extrapolated to scale 0" in text and all(p.is_file() for p in paths)
     assert "(neighbouring levels change by less than 5 % from scale 0.8 on)" in text
     # a level that is not steady makes the verdict undecided, not "not converged"
     steady[0.64] = False
-    cv.write_report(study)
+    cr.write_report(study)
     text = (tmp_path / "convergence.md").read_text()
     assert "particle_size: **undecided**: the level(s) at scale 0.64 did not reach a steady state" in text
     assert "depth: converged within 10 % from scale 1 on" in text
@@ -158,10 +159,10 @@ def test_time_step_levels_join_the_first_sweep_once_the_reference_has_run(mini, 
 
 def test_unrun_levels_are_reported_as_such(mini, tmp_path):
     study = cv.make_study(mini, tmp_path, {"width": (1, 2)})
-    rows = cv.comparison_rows(study)
+    rows = cr.comparison_rows(study)
     assert rows and not any(r["finished"] for r in rows)
-    assert cv.coarsest_converged(study, rows) == {"width": None}
-    cv.write_report(study)
+    assert cr.coarsest_converged(study, rows) == {"width": None}
+    cr.write_report(study)
     assert "not run" in (tmp_path / "convergence.md").read_text()
 
 
@@ -181,15 +182,15 @@ def test_a_linear_series_extrapolates_to_its_intercept_and_the_verdict_follows_i
         return out
 
     study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64), "depth": (1, 2)})
-    monkeypatch.setattr(cv, "_level_values", values)
-    rows = {r["quantity"]: r for r in cv.extrapolation_rows(study)}
+    monkeypatch.setattr(cr, "_level_values", values)
+    rows = {r["quantity"]: r for r in cr.extrapolation_rows(study)}
     assert set(rows) == set(cv.QUANTITIES) and all(r["factor"] == "particle_size" for r in rows.values())
     r = rows["drawbar_pull"]
     assert r["value"] == pytest.approx(500.0, rel=1e-9)
     assert r["reference_error"] == pytest.approx(slope * 500.0, rel=1e-9)
     assert r["birge"] == 1.0 and r["dof"] == 1 and r["reference_error_se"] > 0
     assert all(x["converged"] is converged for x in rows.values())
-    cv.write_report(study)
+    cr.write_report(study)
     text = (tmp_path / "convergence.md").read_text()
     assert "## Extrapolated to zero scale" in text
     assert ("particle_size: converged: extrapolated" in text) is converged
