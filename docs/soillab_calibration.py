@@ -35,10 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.soillab.objective import SINKAGES, score
+
 FRICTIONS = (0.3, 0.5, 0.7)
 ROLLING = (0.1, 0.25, 0.5)
-SINKAGES = (0.005, 0.01, 0.015, 0.02, 0.025)
-REPOSE_UNIT = 2.0  # deg
 
 
 def candidate(mu: float, mu_r: float, cache) -> dict:
@@ -67,7 +67,6 @@ def candidate(mu: float, mu_r: float, cache) -> dict:
     repose = soillab.repose_test(bed_spec, soillab.ReposeSpec(seeds=(0,)), cache_dir=cache)
     measured = soillab.load_plate_curves()
     plates = {}
-    errors = []
     for d in soil_lab.PLATE_DIAMETERS:
         result = soillab.plate_test(bed_spec, soillab.PlateSpec(diameter=d), cache_dir=cache)
         z = np.array(SINKAGES)
@@ -81,24 +80,6 @@ def candidate(mu: float, mu_r: float, cache) -> dict:
            bed.packing_fraction, "bulk_density": bed.packing_fraction * bed_spec.material.density,
            "repose_deg": repose.runs[0].angle, "plates": plates, "wall_seconds": time.perf_counter() - start}
     return score(row)
-
-
-def score(row: dict) -> dict:
-    """The objective of a candidate from its stored curves: the mean squared log-pressure error over the plates'
-    points where both the DEM and the measured mean exist (the 100 mm plates were measured to 17-22 mm only, so
-    their 25 mm point drops out), plus the repose error in units of REPOSE_UNIT."""
-    from wheelsoil.parameters import cmu_k10
-
-    errors = []
-    for plate in row["plates"].values():
-        sim, mea = np.asarray(plate["simulated_Pa"], float), np.asarray(plate["measured_Pa"], float)
-        both = np.isfinite(sim) & np.isfinite(mea) & (sim > 0) & (mea > 0)
-        errors += list(np.log(sim[both] / mea[both]))
-    row["plate_points"] = len(errors)
-    row["plate_log_mse"] = float(np.mean(np.square(errors)))
-    row["repose_error"] = ((row["repose_deg"] - cmu_k10.ANGLE_OF_REPOSE) / REPOSE_UNIT) ** 2
-    row["objective"] = row["plate_log_mse"] + row["repose_error"]
-    return row
 
 
 def run(args) -> int:
@@ -144,7 +125,7 @@ def summary(args) -> int:
         y = np.array([r["objective"] for r in rows])
         basis = lambda p: np.c_[np.ones(len(p)), p, p**2, p[:, :1] * p[:, 1:]]  # noqa: E731
         coef, *_ = np.linalg.lstsq(basis(x), y, rcond=None)
-        res = optimize.minimize(lambda p: float(basis(np.atleast_2d(p)) @ coef), x0=[best["friction"],
+        res = optimize.minimize(lambda p: float((basis(np.atleast_2d(p)) @ coef)[0]), x0=[best["friction"],
                                 best["rolling_friction"]], bounds=[(min(FRICTIONS), max(FRICTIONS)),
                                                                    (min(ROLLING), max(ROLLING))])
         print(f"quadratic surface minimum: sliding {res.x[0]:.3f}, rolling {res.x[1]:.3f} (predicted objective "

@@ -189,3 +189,24 @@ def test_mean_and_spread_over_seeds_is_the_sample_mean_and_deviation(seed):
     assert spread == pytest.approx(values.std(ddof=1), rel=1e-12)
     one = mean_and_spread([values[0]])
     assert one[0] == values[0] and np.isnan(one[1])
+
+
+def test_calibration_objective_on_known_curves():
+    """Equal curves and the sand's repose score 0; a DEM twice too soft everywhere scores (ln 2)^2 over the points
+    both curves reach; 4 deg of repose error adds (4 / 2)^2; the best candidate is the least objective."""
+    from wheelsoil.soillab.objective import SINKAGES, best, score
+
+    z = np.array(SINKAGES)
+    measured = 1e6 * z ** 1.4
+    measured_short = measured.copy()
+    measured_short[-1] = np.nan  # the 100 mm plates end before 25 mm
+    plates = lambda f: {"0.06": {"simulated_Pa": list(f * measured), "measured_Pa": list(measured)},  # noqa: E731
+                        "0.1": {"simulated_Pa": list(f * measured), "measured_Pa": list(measured_short)}}
+    exact = score({"plates": plates(1.0), "repose_deg": 29.0})
+    assert exact["objective"] == pytest.approx(0.0, abs=1e-15) and exact["plate_points"] == 9
+    soft = score({"plates": plates(0.5), "repose_deg": 25.0})
+    assert soft["plate_log_mse"] == pytest.approx(np.log(2.0) ** 2)
+    assert soft["objective"] == pytest.approx(np.log(2.0) ** 2 + 4.0)
+    chosen = best([{"plates": plates(0.5), "repose_deg": 29.0, "id": 1}, {"plates": plates(0.9), "repose_deg": 28.0,
+                                                                            "id": 2}])
+    assert chosen["id"] == 2
