@@ -39,7 +39,7 @@ def test_cli_run_rejects_bad_testbed_input(tmp_path, capsys):
     assert main(["run", "--slip", "1.5", "--out", str(out)]) == EXIT_INPUT
     assert "test.slip = 1.5: Input should be less than 1 (allowed slip >= -1 and < 1)" in capsys.readouterr().err
     assert main(["testbed", "no-such-case", "--out", str(out)]) == EXIT_INPUT
-    assert "no-such-case: no case file or preset of that name; presets: mini-1g-steer" in capsys.readouterr().err
+    assert "no-such-case: no case file or preset of that name; presets: cmu-grouser, cmu-smooth, mini-1g-steer" in capsys.readouterr().err
     assert main(["run", "smoke-moon-steer", "--load", "0", "--out", str(out)]) == EXIT_INPUT
     assert not out.exists()
 
