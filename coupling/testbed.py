@@ -416,6 +416,8 @@ class Testbed:
         self.gravity = -float(bs.gravity[2])
         # the hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] (kinematics.rig_command)
         self.spin_command, self.travel_speed = carriage_speed(spec, wheel.radius)
+        #: the commanded speed [m/s] the slip is taken against (spec.slip_speed: along the heading, or the travel)
+        self.slip_reference_speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)[1]
         #: the rate [rad/s] at which the statistics' batches pass: the hub's spin, or for a dragged wheel (no
         #: spin) the angle it would roll through at its travel speed
         self.batch_rate = batch_rate(spec.slip, spec.angular_velocity, wheel.radius)
@@ -680,8 +682,7 @@ class Testbed:
         n_pitch = int(math.ceil(self.pitch / self.batch_rate / (self.steps_per_sample * self.dt)))
         if len(t) < n_pitch or t[-n_pitch] < self._loop["t_windup"]:
             return False
-        r = self.wheel.radius
-        v = rig_command(s.slip, s.angular_velocity, r)[1]  # the speed the slip is taken against
+        r, v = self.wheel.radius, self.slip_reference_speed
         slip_error = abs(longitudinal_slip(v, float(omega_t[-n_pitch:].mean()), r) - s.slip)
         spin_error = abs(longitudinal_slip(v, self._loop["hub_spin"], r) - s.slip)
         return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
@@ -820,8 +821,7 @@ class _ProgressBar:
         if loop["phase"] in ("wind-up", "drive"):
             n = max(1, int(b.pitch / b.batch_rate / (b.steps_per_sample * b.dt)))
             omega_t = float(np.mean(rows["tread_omega"][-n:]))
-            v = rig_command(s.slip, s.angular_velocity, b.wheel.radius)[1]
-            slip = longitudinal_slip(v, omega_t, b.wheel.radius)
+            slip = longitudinal_slip(b.slip_reference_speed, omega_t, b.wheel.radius)
             text += f"  tread slip {slip:.3f} (commanded {s.slip:g})"
         self.bar.update(self.task, total=total, completed=completed, description=text)
 
