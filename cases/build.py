@@ -42,6 +42,7 @@ def bed_spec(case: CaseFile) -> BedSpec:
         material=Material(smoke.SOIL_MATERIAL.name, s.youngs_modulus, s.poisson_ratio, s.density),
         pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
         seed=case.case.seed, max_settle_time=s.max_settle_time, periodic=s.periodic,
+        pour_friction_factor=s.pour_friction_factor,
     )
 
 

@@ -359,6 +359,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="leave-one-condition-out cross-validation instead of one hold-out: each level of CONDITION "
                         "(slip_angle, load, gravity, slip, passes, grouser_height, group) held out in turn; writes "
                         "crossval.md and crossval.json to --report")
+    p.add_argument("--shear-form", choices=("independent", "resultant"), default="independent",
+                   help="the semi-empirical model's shear: 'independent' (classical: each direction saturates on its "
+                        "own displacement) or 'resultant' (the CMU lab's model: one strength, shared along the slip "
+                        "velocity)")
     p.set_defaults(func=cmd_validate)
 
     soil_lab_command.add_parser(sub)

@@ -124,6 +124,9 @@ class Soil(_Section):
                                        _TEST["time_step"])
     max_settle_time: float = _q(smoke.SOIL["max_settle_time"], "s", "give up preparing the bed after this much "
                                 "settling", _BED["max_settle_time"])
+    pour_friction_factor: float = _q(1.0, "1", "sliding and rolling friction are multiplied by this while the bed is "
+                                     "poured: 1 a loose pour, 0 frictionless spheres, the densest bed; the run uses "
+                                     "the friction above", _BED["pour_friction_factor"])
 
     @field_validator("gravity")
     @classmethod
@@ -295,6 +298,8 @@ class CaseFile(BaseModel):
         # keys added after cases were stored leave a case's hash as it was while they hold their default
         if data["test"]["slip_speed"] == "heading":
             data["test"].pop("slip_speed")
+        if data["soil"]["pour_friction_factor"] == 1.0:
+            data["soil"].pop("pour_friction_factor")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 

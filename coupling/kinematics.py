@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wheelsoil.rigid_motion import deformation, rigid_fit, rotation_vector  # noqa: F401  (re-exported)
+from wheelsoil.slip import longitudinal_slip  # noqa: F401  (the shared definition, re-exported)
 
 
 @dataclass(frozen=True)
@@ -76,24 +77,6 @@ class TreadTracker:
             heading=heading,
             axle=np.cross([0.0, 0.0, 1.0], heading),
         )
-
-
-def longitudinal_slip(travel_speed_along_heading, spin, radius: float):
-    """Longitudinal slip by the measured rigs' convention (architecture): driving (r omega >= v_x),
-    i = 1 - v_x / (r omega) (seed 004 eq. 14); braking (r omega < v_x), i = r omega / v_x - 1, so a wheel dragged
-    without turning has i = -1 and a free-rolling one 0 on both branches (the CMU rig's definitions,
-    ``../shared/data/measured/cmu_3d_terramechanics/README.md``). 0 where neither the wheel travels nor turns.
-
-    travel_speed_along_heading: v_x [m/s]; spin: omega [rad/s] (the hub's, or the tread's own for the tread
-    slip); radius: r [m]. Scalars or arrays (broadcast)."""
-    v = np.asarray(travel_speed_along_heading, float)
-    rim = radius * np.asarray(spin, float)
-    v, rim = np.broadcast_arrays(v, rim)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        driving = np.where(rim > 0.0, 1.0 - v / np.where(rim > 0.0, rim, 1.0), 0.0)
-        braking = np.where(v > 0.0, rim / np.where(v > 0.0, v, 1.0) - 1.0, 0.0)
-    out = np.where(rim >= v, driving, braking)
-    return out if out.ndim else float(out)
 
 
 def rig_command(slip: float, reference_spin: float, radius: float) -> tuple[float, float]:

@@ -6,6 +6,7 @@ Usage (from the repository root, ``../shared`` beside it; about 15 min a candida
 
     python docs/soillab_calibration.py run --out docs/soillab/calibration [--resume] [--cache DIR] [--max-candidates N]
     python docs/soillab_calibration.py summary docs/soillab/calibration
+    python docs/soillab_calibration.py run --design packing --out docs/soillab/packing --resume --cache DIR
 
 What each candidate does, chosen before any result was seen:
 
@@ -23,6 +24,16 @@ surface fitted to the grid (scipy) are reported. The design grid: sliding fricti
 (docs/soillab/baseline): rolling friction is what raises a sphere packing's angle of repose, so the grid reaches
 well above the baseline's. The wheel-sinkage curves are not used: they are the held-out check of the calibrated
 particles.
+
+Design "packing" (2026-11-27, fixed after the friction grid and before any of its own results). Every friction
+candidate's plates were a factor of two too soft, and the measured plates' pressure needs, by Meyerhof's circular
+footing with c = 0, a friction angle of at least 33.5 deg (100 mm plate at 20 mm; Terzaghi 36 deg) against the
+lab's 28.6 deg shear-box angle, while the repose is already matched. A sand's peak angle rises above its repose
+angle with its packing density (dilatancy); a poured sphere bed with sliding and rolling friction 0.5 is at its
+loosest. The design keeps the repose match (sliding 0.5, rolling 0.5) and pours the bed denser by multiplying the
+friction by 0 (densest) and 0.25 while it settles (``BedSpec.pour_friction_factor``), next to the loose pour (1) as
+reference; each candidate also runs the shear box (5 / 10 / 20 kPa) so the peak angle the hypothesis rests on is
+measured, and is scored by the same objective as the grid.
 """
 
 from __future__ import annotations
@@ -39,9 +50,18 @@ from wheelsoil.soillab.objective import SINKAGES, score
 
 FRICTIONS = (0.3, 0.5, 0.7)
 ROLLING = (0.1, 0.25, 0.5)
+#: (sliding friction, rolling friction, pour friction factor, with the shear box) of every candidate, per design.
+DESIGNS = {
+    "friction": tuple((mu, mu_r, 1.0, False) for mu in FRICTIONS for mu_r in ROLLING),
+    "packing": ((0.5, 0.5, 0.0, True), (0.5, 0.5, 0.25, True), (0.5, 0.5, 1.0, True)),
+}
 
 
-def candidate(mu: float, mu_r: float, cache) -> dict:
+def candidate_name(mu: float, mu_r: float, pour: float) -> str:
+    return f"mu{mu:g}_mur{mu_r:g}" + ("" if pour == 1.0 else f"_pour{pour:g}")
+
+
+def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False) -> dict:
     from wheelsoil import soillab
     from wheelsoil.granular.bed import BedSpec, prepare_bed
     from wheelsoil.material import Material, PairProperties
@@ -56,7 +76,7 @@ def candidate(mu: float, mu_r: float, cache) -> dict:
                             density=density)
         return BedSpec(**soil_lab.PLATE_BOX, diameter_min=soil_lab.DIAMETER_MIN, diameter_max=soil_lab.DIAMETER_MAX,
                        material=material, pair=pair, wall_material=soil_lab.TOOL_MATERIAL,
-                       wall_pair=soil_lab.TOOL_PAIR, periodic=False, seed=0)
+                       wall_pair=soil_lab.TOOL_PAIR, periodic=False, seed=0, pour_friction_factor=pour)
 
     bed_spec = spec(base.density)
     bed = prepare_bed(bed_spec, cache_dir=cache)
@@ -76,9 +96,20 @@ def candidate(mu: float, mu_r: float, cache) -> dict:
         plates[str(d)] = {"sinkage_m": list(z), "simulated_Pa": list(sim / area), "measured_Pa": list(mea / area),
                           "measured_sd_Pa": list(mea_sd / area), "wall_seconds": result.wall_seconds,
                           "top_offset_m": result.top_offset, "inertial_number": result.inertial_number}
-    row = {"friction": mu, "rolling_friction": mu_r, "density": bed_spec.material.density, "packing_fraction":
+    row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour,
+           "density": bed_spec.material.density, "packing_fraction":
            bed.packing_fraction, "bulk_density": bed.packing_fraction * bed_spec.material.density,
-           "repose_deg": repose.runs[0].angle, "plates": plates, "wall_seconds": time.perf_counter() - start}
+           "repose_deg": repose.runs[0].angle, "plates": plates}
+    if shear:
+        result = soillab.shear_test(bed_spec, soillab.ShearSpec(), cache_dir=cache)
+        row["shear"] = {"normal_stress_Pa": [r.plane_normal for r in result.runs],
+                        "peak_shear_Pa": [r.peak for r in result.runs], "dilation_m": [float(r.cap_rise[-1]) for r in result.runs],
+                        "peak_friction_angle_deg": result.peak.friction_angle,
+                        "peak_friction_angle_se_deg": result.peak.friction_angle_se,
+                        "peak_cohesion_Pa": result.peak.cohesion, "peak_cohesion_se_Pa": result.peak.cohesion_se,
+                        "residual_friction_angle_deg": result.residual.friction_angle,
+                        "residual_cohesion_Pa": result.residual.cohesion, "bulk_density": result.bulk_density}
+    row["wall_seconds"] = time.perf_counter() - start
     return score(row)
 
 
@@ -86,22 +117,23 @@ def run(args) -> int:
     out = Path(args.out)
     (out / "candidates").mkdir(parents=True, exist_ok=True)
     ran = 0
-    for mu in FRICTIONS:
-        for mu_r in ROLLING:
-            path = out / "candidates" / f"mu{mu:g}_mur{mu_r:g}.json"
-            if args.resume and path.is_file():
-                print(f"{path.name}: done before, kept", flush=True)
-                continue
-            if args.max_candidates is not None and ran >= args.max_candidates:
-                print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
-                return summary(args)
-            ran += 1
-            row = candidate(mu, mu_r, args.cache)
-            tmp = path.with_suffix(".partial")
-            tmp.write_text(json.dumps(row, indent=1))
-            tmp.replace(path)
-            print(f"{path.name}: objective {row['objective']:.4f} (plates {row['plate_log_mse']:.4f}, repose "
-                  f"{row['repose_deg']:.1f} deg), density {row['density']:g}, {row['wall_seconds']:.0f} s", flush=True)
+    for mu, mu_r, pour, shear in DESIGNS[args.design]:
+        path = out / "candidates" / f"{candidate_name(mu, mu_r, pour)}.json"
+        if args.resume and path.is_file():
+            print(f"{path.name}: done before, kept", flush=True)
+            continue
+        if args.max_candidates is not None and ran >= args.max_candidates:
+            print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
+            return summary(args)
+        ran += 1
+        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear)
+        tmp = path.with_suffix(".partial")
+        tmp.write_text(json.dumps(row, indent=1))
+        tmp.replace(path)
+        extra = f", peak angle {row['shear']['peak_friction_angle_deg']:.1f} deg" if "shear" in row else ""
+        print(f"{path.name}: objective {row['objective']:.4f} (plates {row['plate_log_mse']:.4f}, repose "
+              f"{row['repose_deg']:.1f} deg{extra}), packing {row['packing_fraction']:.3f}, density "
+              f"{row['density']:g}, {row['wall_seconds']:.0f} s", flush=True)
     return summary(args)
 
 
@@ -138,6 +170,7 @@ def main(argv=None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run")
     p.add_argument("--out", default="docs/soillab/calibration")
+    p.add_argument("--design", choices=sorted(DESIGNS), default="friction")
     p.add_argument("--resume", action="store_true")
     p.add_argument("--cache", default=None)
     p.add_argument("--max-candidates", type=int, default=None, help="run at most this many (a session's share)")

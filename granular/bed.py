@@ -4,7 +4,10 @@ Protocol (as a lab prepares a soil bin, and as seed 004 section 2.3 prepares its
 
 1. *Fill*: polydisperse spheres (diameters uniform in [d_min, d_max]) on a jittered loose lattice
    above the bin floor, enough for ``overfill`` times the target depth at packing fraction 0.6.
-2. *Settle* under the gravity the bed will be tested at, until the kinetic energy per particle
+2. *Settle* under the gravity the bed will be tested at (with the sliding and rolling friction of every pair
+   multiplied by ``pour_friction_factor``: 1, the default, is a loose pour; below 1 the spheres slide into a
+   denser packing, the DEM's usual way to set a sample's density, e.g. Salot, Gotteland & Villard 2009,
+   Granular Matter 11:221, section 2.2), until the kinetic energy per particle
    falls below a threshold (default: that of the mean particle moving at 5 mm/s).
 3. *Level*: remove every sphere whose centre lies above the target height, then settle again.
 4. *Measure*: surface height (mean over d_max-wide columns of the highest sphere top) and the bulk
@@ -71,6 +74,10 @@ class BedSpec:
     time_step: DEM time step [s] of the preparation; ``None`` uses the stable estimate.
     periodic: the bin is periodic along x (no end walls; :class:`~.scene.Scene` ``periodic_x``): a soil
         patch that a moving-patch testbed can shift without end (``wheelsoil.coupling.patch``).
+    pour_friction_factor: the sliding and rolling friction of the soil--soil and soil--wall pairs are multiplied
+        by this while the bed is poured, settled and levelled [-], in [0, 1]. 1 (default) pours with the particles'
+        own friction, a loose packing; 0 pours frictionless spheres, the densest packing. The bed keeps
+        ``pair`` and ``wall_pair`` for every test made on it.
     """
 
     length: float = smoke.SOIL["length"]
@@ -89,6 +96,7 @@ class BedSpec:
     overfill: float = 1.15
     time_step: float | None = None
     periodic: bool = smoke.SOIL["periodic"]
+    pour_friction_factor: float = 1.0
 
     #: Allowed range of every scalar input (None: the computed default). The case schema's [soil] fields take
     #: their bounds from here.
@@ -96,6 +104,7 @@ class BedSpec:
         "length": positive(), "width": positive(), "depth": positive(), "diameter_min": positive(),
         "diameter_max": positive(), "max_settle_time": positive(), "seed": Range(lo=0, integer=True),
         "overfill": Range(1.0, 3.0), "kinetic_energy_threshold": positive(), "time_step": positive(),
+        "pour_friction_factor": Range(0.0, 1.0),
     }
     UNITS: ClassVar[dict[str, str]] = {
         "length": "m", "width": "m", "depth": "m", "diameter_min": "m", "diameter_max": "m", "max_settle_time": "s",
@@ -150,7 +159,16 @@ class BedSpec:
         d["gravity"] = list(self.gravity)
         if not self.periodic:  # beds prepared before periodic bins existed keep their cache keys
             d.pop("periodic")
+        if self.pour_friction_factor == 1.0:  # and so do loose pours, made before the factor existed
+            d.pop("pour_friction_factor")
         return d
+
+    def pour_pair(self, pair: PairProperties) -> PairProperties:
+        """``pair`` as it is while the bed is poured: its sliding and rolling friction times
+        ``pour_friction_factor``."""
+        f = self.pour_friction_factor
+        return dataclasses.replace(pair, static_friction=pair.static_friction * f,
+                                   rolling_friction=pair.rolling_friction * f)
 
     @classmethod
     def from_dict(cls, d: dict) -> BedSpec:
@@ -482,10 +500,10 @@ def prepare_bed(
     scene = Scene(
         (0.0, 0.0, 0.0),
         (spec.length, spec.width, max(fill_top, spec.depth) + spec.diameter_max * 2),
-        gravity=spec.gravity, material=spec.material, pair=spec.pair, arch=arch,
+        gravity=spec.gravity, material=spec.material, pair=spec.pour_pair(spec.pair), arch=arch,
         impact_speed=max(1.0, math.sqrt(2 * spec.gravity_magnitude * fill_top)), periodic_x=spec.periodic,
     )
-    scene.add_box_walls(material=spec.wall_material, pair=spec.wall_pair)
+    scene.add_box_walls(material=spec.wall_material, pair=spec.pour_pair(spec.wall_pair))
     scene.add_spheres(positions, radii)
     if spec.time_step is not None:
         scene.time_step = spec.time_step

@@ -42,8 +42,29 @@ def test_same_bed_is_reused_from_cache(cache):
     assert again.meta["from_cache"]
     np.testing.assert_array_equal(again.positions, first.positions)
     # any parameter that shapes the bed changes the key
-    for change in (dict(seed=1), dict(gravity=(0, 0, -1.62)), dict(diameter_max=0.022), dict(depth=0.07)):
+    for change in (dict(seed=1), dict(gravity=(0, 0, -1.62)), dict(diameter_max=0.022), dict(depth=0.07),
+                   dict(pour_friction_factor=0.5)):
         assert bed_cache_path(BedSpec(**{**TINY, **change}), cache) != bed_cache_path(spec, cache)
+    # a loose pour (the default) keeps the key it had before the pour's friction could be set
+    assert "pour_friction_factor" not in spec.to_dict()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_frictionless_pour_packs_denser_and_the_bed_keeps_its_friction(cache, seed):
+    """Salot et al. (2009): the friction while the sample is made sets its density. Spheres with sliding and rolling
+    friction 0.5 pour loose (random loose packing, about 0.55-0.58); poured frictionless they slide towards random
+    close packing (0.64 for equal spheres, a little more for these 12-18 mm ones). Both beds are tested with the
+    pair's own friction."""
+    from wheelsoil.material import PairProperties
+
+    rough = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.5)
+    base = dict(length=0.2, width=0.2, depth=0.1, diameter_min=0.012, diameter_max=0.018, periodic=False, seed=seed,
+                pair=rough)
+    loose = prepare_bed(BedSpec(**base), cache_dir=cache)
+    dense = prepare_bed(BedSpec(**base, pour_friction_factor=0.0), cache_dir=cache)
+    assert dense.packing_fraction > loose.packing_fraction + 0.03, (loose.packing_fraction, dense.packing_fraction)
+    assert dense.packing_fraction < np.pi / (3 * np.sqrt(2))  # below the densest packing of spheres (Kepler)
+    assert dense.spec.pair == rough and dense.spec.pour_pair(rough).static_friction == 0.0
 
 
 def test_bed_hdf5_round_trip_and_provenance(cache, tmp_path):

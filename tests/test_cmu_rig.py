@@ -77,6 +77,7 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
     from wheelsoil.cases.cmu_sweep import write_presets
     from wheelsoil.cases.sweep import load_sweep
     from wheelsoil.validation.compare import match_conditions
+    from wheelsoil.slip import heading_slip_from_travel
     from wheelsoil.validation.measured import Measurements, load_cmu_trials
 
     folder = Path(measured_dir) / "cmu_3d_terramechanics"
@@ -95,8 +96,11 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
 
     geometry = [specs(c.case)[1] for c in full.cases]
     n = len(full.cases)
+    # the rig's slip (travel) read along the heading, as load_sweep_summary reads a travel-convention run
+    assert all(c.case.test.slip_speed == "travel" for c in full.cases)
     simulated = Measurements(
-        name="cmu-trials", slip=np.array([c.case.test.slip for c in full.cases]),
+        name="cmu-trials", slip=heading_slip_from_travel([c.case.test.slip for c in full.cases],
+                                                         [c.case.test.slip_angle for c in full.cases]),
         slip_angle=np.array([c.case.test.slip_angle for c in full.cases]),
         load=np.array([c.case.test.load for c in full.cases]),
         gravity=np.array([-c.case.soil.gravity_vector[2] for c in full.cases]),

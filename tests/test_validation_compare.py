@@ -80,3 +80,21 @@ def test_cli_model_sweep_report(tmp_path):
     text = (out / "report.md").read_text()
     assert "18 measured conditions have a simulated run" in text and "| drawbar_pull | 18 | +3 N |" in text
     assert (out / "measured_vs_simulated.png").stat().st_size > 1000
+
+
+def test_a_run_with_the_rigs_slip_pairs_with_the_trial_at_the_same_heading_slip(tmp_path):
+    """A case run with ``test.slip_speed = "travel"`` (the CMU rig's slip) is read along the heading, as the CMU
+    loader reads the rig's rows; heading-convention runs are kept as they are."""
+    from wheelsoil.slip import heading_slip_from_travel
+
+    path = tmp_path / "sweep"
+    path.mkdir()
+    table = {"slip_set": [0.5, 0.5, -0.5], "slip_angle_set": [60.0, 60.0, 30.0], "slip_speed": ["travel", "heading",
+                                                                                               "travel"],
+             "load_set": [25.0] * 3, "gravity": [9.81] * 3, "wheel_radius": [0.058] * 3, "wheel_width": [0.05] * 3,
+             "grouser_count": [0] * 3, "grouser_height": [0.0] * 3}
+    for src in ("drawbar_pull", "lateral_force", "tread_sinkage", "torque"):
+        table[f"{src}_mean"], table[f"{src}_std"] = [1.0] * 3, [0.1] * 3
+    pd.DataFrame(table).to_csv(path / "summary.csv", index=False)
+    sim = load_sweep_summary(path)
+    np.testing.assert_allclose(sim.slip, [0.75, 0.5, heading_slip_from_travel(-0.5, 30.0)])

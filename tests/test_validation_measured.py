@@ -38,7 +38,8 @@ def test_cmu_trials_in_si(measured_dir):
     assert 0 < len(driving) < len(everything)
     assert np.all((driving.slip >= 0) & (driving.slip < 1))
     assert set(np.unique(driving.group)) == {"grouser", "smooth"}
-    assert set(np.unique(driving.slip_angle)) >= {0.0, 30.0, 60.0, 90.0}
+    # slip along the heading: a turning wheel at 90 deg has slip 1, outside the driving branch
+    assert set(np.unique(driving.slip_angle)) >= {0.0, 30.0, 60.0} and 90.0 not in driving.slip_angle
     assert np.all(driving.load > 0) and np.all(driving.radius == 0.058)
 
 
@@ -67,6 +68,13 @@ def test_bad_files_name_the_problem(tmp_path):
     (tmp_path / "smooth_wheel_trials.csv").write_text("slip,drawbar_pull_N\n0.1,3\n")
     with pytest.raises(WheelsoilInputError, match=r"missing column\(s\) \['wheel', 'steering_angle'"):
         load_cmu_trials(tmp_path)
+    header = "wheel,steering_angle_deg,slip,drawbar_pull_N,lateral_force_N,vertical_load_N,sinkage_mm\n"
+    for bad, match in (("grouser,30,1.5,1,1,20,5", r"column 'slip' holds 1.5 in data row 2 .* \[-1, 1\]"),
+                       ("grouser,120,0.5,1,1,20,5", r"column 'steering_angle' holds 120 deg in data row 2 .* "
+                                                    r"\[-90, 90\] deg")):
+        missing.write_text(header + "grouser,0,0.2,1,1,20,5\n" + bad + "\n")
+        with pytest.raises(WheelsoilInputError, match=match):
+            load_cmu_trials(tmp_path)
 
 
 def test_sweep_summary_reads_as_simulated_data_and_a_partial_table_is_refused(tmp_path):

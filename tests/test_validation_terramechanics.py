@@ -63,6 +63,34 @@ def test_fully_mobilised_shear_matches_the_closed_form():
     assert out["torque"][0] == pytest.approx(r * r * b * k * mu * t, rel=1e-6)
 
 
+def test_resultant_shear_is_the_classical_form_straight_ahead_and_shares_the_strength_sideways():
+    """The CMU lab's shear form (``shear_form = "resultant"``, Pavlov's tau_t.m / tau_l.m): at 0 deg and driving
+    slip the slip velocity is along the heading, so it is the classical form exactly; fully mobilised (tiny k_x) at
+    89.99 deg the whole strength acts along the axle: lateral force r b k mu t (the closed form of the torque's
+    integral), no shear along the heading, so drawbar pull is the compaction resistance -r b k int(...) sin and the
+    torque vanishes, where the classical form keeps both directions at full strength."""
+    for slip in (0.05, 0.3, 0.8):
+        for z in (0.01, 0.04):
+            a = contact_forces(SAND, WHEEL, z, slip, 0.0, 9.81)
+            b_ = contact_forces(replace(SAND, shear_form="resultant"), WHEEL, z, slip, 0.0, 9.81)
+            for q in ("drawbar_pull", "vertical_force", "torque"):
+                assert b_[q][0] == pytest.approx(a[q][0], rel=1e-12, abs=1e-12)
+    soil = _linear_soil(shear_modulus_x=1e-9, shear_modulus_y=1e-9, sidewall_scale=0.0)
+    z, g = 0.03, 9.81
+    r, b = WHEEL.radius, WHEEL.width
+    k = soil.density * g * b * soil.kphi_prime * (r / b)
+    mu = np.tan(np.radians(soil.friction_angle))
+    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    out = contact_forces(replace(soil, shear_form="resultant"), WHEEL, z, 0.5, 89.99, g)
+    assert abs(out["lateral_force"][0]) == pytest.approx(r * b * k * mu * t, rel=1e-3)
+    assert out["drawbar_pull"][0] == pytest.approx(-r * b * k * bb, rel=1e-3)
+    assert abs(out["torque"][0]) < 1e-3 * r * r * b * k * mu * t
+    classical = contact_forces(soil, WHEEL, z, 0.5, 89.99, g)
+    assert classical["drawbar_pull"][0] == pytest.approx(r * b * k * (mu * a - bb), rel=1e-3)
+    with pytest.raises(WheelsoilInputError, match="shear_form = 'sideways'"):
+        replace(SAND, shear_form="sideways")
+
+
 def test_quadrature_matches_adaptive_integration_with_a_rear_region():
     """Default sand (n = 1.1, theta_m = (a1 + a2 i) theta_f, rebound c3): Gauss--Legendre vs scipy quad."""
     soil = replace(SAND, c3=0.2)

@@ -32,17 +32,18 @@ def levels(data: Measurements, by: str) -> list:
 
 
 def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, bootstrap: int = 400,
-                   progress=None) -> dict:
+                   progress=None, start=None) -> dict:
     """Hold out each level of ``by`` in turn (see the module docstring). Returns a dict with one fold per level:
     the mechanisms found, the classical and final model's normalised RMSE on the held-out level, the gain and its
-    bootstrap standard deviation. A mechanism accepted on the rest but not named (``partial``: the model still
+    bootstrap standard deviation. ``start``: the soil every fold starts from (:func:`.discovery.discover`), e.g.
+    with the lab's ``shear_form``. A mechanism accepted on the rest but not named (``partial``: the model still
     leaves a systematic residual where it acts) is in the final model, so it can carry a gain."""
     values = np.asarray(getattr(data, by))
     folds = []
     rng = np.random.default_rng(seed)
     for level in levels(data, by):
         mask = values == level
-        d = discover(data, responses=responses, heldout=mask, seed=seed, bootstrap=bootstrap)
+        d = discover(data, responses=responses, heldout=mask, seed=seed, bootstrap=bootstrap, start=start)
         test = data.select(mask)
         base = normalised_residuals(d.baseline.soil, test, d.responses, d.scales)
         final = normalised_residuals(d.final.soil, test, d.responses, d.scales)

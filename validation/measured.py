@@ -20,6 +20,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
 from wheelsoil.parameters import cmu_k10
+from wheelsoil.slip import heading_slip_from_travel
 
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
@@ -158,9 +159,15 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
     """One CMU trial file (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv`` or a file of the same
     columns): the wheel of each row from its ``wheel`` column (``grouser`` or ``smooth``).
 
+    Slip is converted to wheelsoil's convention (:func:`wheelsoil.slip.heading_slip_from_travel`): the rig takes
+    slip against the carriage's whole speed V, wheelsoil and its model against V's component along the heading,
+    V cos(beta). At 60 deg the rig's 0.5 is 0.75 here; at 90 deg a turning wheel has slip 1 (it does not advance
+    along its heading) and a dragged one 0 (it neither advances nor turns).
+
     The soil carries ``vertical_load``; sinkage is kept as recorded (the lab's zero is the wheel's start
     position, not the soil surface, so only its changes are comparable). ``driving_only`` keeps rows with
-    0 <= slip < 1 (the model's driving branch); dragged-wheel rows (slip -1) and braking rows are dropped.
+    0 <= slip < 1 below 90 deg (the model's driving branch): rows braking along the heading
+    (r omega < V cos beta), dragged wheels and every 90 deg row are dropped.
     The grouser count is not in the files: 0 for both (grousers enter through their height only where a
     model asks for it).
 
@@ -178,9 +185,16 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
     n = len(group)
     col = lambda key: np.asarray(t.columns[key], float)  # noqa: E731
     opt = lambda key: col(key) if key in t.columns else np.full(n, np.nan)  # noqa: E731
+    for key, lo, hi, unit in (("slip", -1.0, 1.0, ""), ("steering_angle", -90.0, 90.0, " deg")):
+        bad = np.flatnonzero(~((col(key) >= lo) & (col(key) <= hi)))
+        if bad.size:
+            raise WheelsoilInputError(f"{path}: column {key!r} holds {col(key)[bad[0]]:g}{unit} in data row "
+                                      f"{bad[0] + 1} ({bad.size} such row(s)); the rig's {key} lies in "
+                                      f"[{lo:g}, {hi:g}]{unit}")
     data = Measurements(
         name=Path(path).stem,
-        slip=col("slip"), slip_angle=col("steering_angle"), load=col("vertical_load"),
+        slip=heading_slip_from_travel(col("slip"), col("steering_angle")), slip_angle=col("steering_angle"),
+        load=col("vertical_load"),
         gravity=np.full(n, EARTH_GRAVITY), radius=np.full(n, cmu_k10.RADIUS), width=np.full(n, cmu_k10.WIDTH),
         grouser_height=np.array([cmu_k10.GROUSER_HEIGHT[g] for g in group]), grouser_count=np.zeros(n),
         group=group,
@@ -192,7 +206,7 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
         sinkage_relative=True,
     )
     if driving_only:
-        data = data.select((data.slip >= 0.0) & (data.slip < 1.0))
+        data = data.select((data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) < 90.0))
     return data
 
 
@@ -278,7 +292,9 @@ def load_sweep_summary(path: str | Path) -> Measurements:
 
     Sinkage is the tread sinkage (the rut depth below the levelled surface, without the wheel's
     deflection), the quantity the rigid-wheel model predicts; the lateral force keeps wheelsoil's sign
-    (it opposes the lateral slip). Groups are the gravity levels ("1g", "moon" or the value).
+    (it opposes the lateral slip). Groups are the gravity levels ("1g", "moon" or the value). A case run with
+    ``test.slip_speed = "travel"`` (the CMU rig's convention) has its slip converted to the heading's, as
+    :func:`load_cmu_file` converts the rig's, so simulated and measured rows pair at the same slip.
     """
     import pandas as pd
 
@@ -297,8 +313,12 @@ def load_sweep_summary(path: str | Path) -> Measurements:
     g = t["gravity"].to_numpy(float)
     group = np.array([gravity_label(v, moon="moon", other="g{g:.3g}") for v in g])
     col = lambda key: t[key].to_numpy(float)  # noqa: E731
+    slip = col("slip_set")
+    if "slip_speed" in t.columns:
+        travel = t["slip_speed"].astype(str).to_numpy() == "travel"
+        slip = np.where(travel, heading_slip_from_travel(slip, col("slip_angle_set")), slip)
     return Measurements(
-        name=path.parent.name, slip=col("slip_set"), slip_angle=col("slip_angle_set"), load=col("load_set"),
+        name=path.parent.name, slip=slip, slip_angle=col("slip_angle_set"), load=col("load_set"),
         gravity=g, radius=col("wheel_radius"), width=col("wheel_width"), grouser_height=col("grouser_height"),
         grouser_count=col("grouser_count"), group=group.astype(str),
         responses={q: col(f"{src}_mean") for q, src in SIMULATED_RESPONSES.items()},

@@ -184,6 +184,9 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
              "conditions; residuals normalised by the training data's spread.", ""]
     if excluded:
         lines += [f"Excluded: {excluded}", ""]
+    if findings.get("shear_form", "independent") != "independent":
+        lines += [f"Shear form: {findings['shear_form']} (the classical model and every candidate share it; "
+                  "`--shear-form`)", ""]
     if command:
         lines += ["Reproduce: `" + command + "`", ""]
     lines += ["## Verdict", ""] + [f"- {v}" for v in verdict_lines(findings)]

@@ -20,7 +20,12 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
 * shear, Janosi--Hanamoto with Mohr--Coulomb strength (seed 003 eqs. 9--10, 13)::
 
       tau_x = (c + sigma tan phi)(1 - exp(-j_x / k_x)),   tau_y = (c + sigma tan phi)(1 - exp(-j_y / k_y))
-  with the shear displacements of seed 003 eqs. 12 and 16;
+  with the shear displacements of seed 003 eqs. 12 and 16; or, with ``shear_form = "resultant"`` (the CMU
+  lab's 3-D model, Pavlov, robomechanics/3d-terramechanics ``tau_t.m``, ``tau_l.m``), the strength mobilised by
+  the resultant displacement and directed along the soil's slip velocity (v_jt, v_jl) under the rim::
+
+      (tau_x, tau_y) = (c + sigma tan phi)(1 - exp(-sqrt(j_x^2 + j_y^2) / k_x)) (v_jt, |v_jl|) / |v_j|,
+      v_jt = r omega (1 - eta) - v_x cos theta  (``v_jt.m``),   v_jl = v_y = v_x tan beta;
 * force integrals (seed 000 eqs. 9--11 in 3-D form, Ishigami et al. 2007)::
 
       F_x = r b  int (tau_x cos theta - sigma sin theta) d theta
@@ -53,6 +58,9 @@ from wheelsoil.gravity import EARTH_GRAVITY
 #: Gauss--Legendre nodes per contact region (front and rear of theta_m); 48 integrate the smooth stress
 #: profiles to better than 1e-8 relative (see tests/test_validation_terramechanics.py).
 QUADRATURE_POINTS = 48
+
+#: How the shear stress is split between the heading and the axle (:class:`SoilParameters` ``shear_form``).
+SHEAR_FORMS = ("independent", "resultant")
 
 #: Classical soil parameters a drift may act on. The drifted value enters the Wong--Reece and Janosi--Hanamoto
 #: stresses (normal stress, shear strength and displacement, theta_m); the sidewall, bulldozing and grouser terms
@@ -87,6 +95,9 @@ class SoilParameters:
     shear_modulus_x, shear_modulus_y: shear deformation moduli k_x, k_y [m].
     a1, a2: theta_m = (a1 + a2 i) theta_f [-] (Oida; Wong--Reece).
     c3: exit angle ratio, theta_r = -c3 theta_f [-] (0: the soil does not rebound behind the wheel).
+    shear_form: "independent" (classical, Ishigami et al. 2007: each direction's shear stress saturates at the
+        full strength on its own displacement) or "resultant" (the CMU lab's model: one strength, mobilised by the
+        resultant displacement and shared between the directions as the slip velocity is; module docstring).
 
     Mechanisms beyond the classical model (see :mod:`wheelsoil.validation.extensions`, which names them):
 
@@ -127,6 +138,7 @@ class SoilParameters:
     a1: float = 0.33
     a2: float = 0.11
     c3: float = 0.0
+    shear_form: str = "independent"
     soil_flow: float = 0.0
     sidewall_scale: float = 1.0
     grouser_scale: float = 1.0
@@ -166,6 +178,8 @@ class SoilParameters:
                 f"a1 = {self.a1!r}, a2 = {self.a2!r} put theta_m outside the contact: allowed 0 <= a1 < 1 and "
                 f"0 <= a1 + a2 <= 1")
 
+        if self.shear_form not in SHEAR_FORMS:
+            raise WheelsoilInputError(f"shear_form = {self.shear_form!r}: allowed {list(SHEAR_FORMS)}")
         if self.drift_field not in ("",) + DRIFT_FIELDS:
             raise WheelsoilInputError(f"drift_field = {self.drift_field!r}: allowed {list(DRIFT_FIELDS)} or ''")
         if self.drift_condition not in ("",) + tuple(DRIFT_MEASURES):
@@ -297,7 +311,22 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     jx = np.where(driving, r * (sweep - (1.0 - i[:, None]) * (np.sin(tf) - np.sin(theta))),
                   r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
-    tau_x = strength * (1.0 - np.exp(-jx / np.broadcast_to(shear_modulus, i.shape)[:, None]))
+    k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
+    jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
+    jy = jy * np.abs(np.tan(beta))[:, None]
+    if soil.shear_form == "resultant":
+        # the slip velocity under the rim in units of r omega (v_jt.m; v_x = (1 - i) r omega driving,
+        # r omega / (1 + i) braking): its direction shares the strength the resultant displacement mobilises
+        eta_c = (1.0 - eta)[:, None]
+        to_rim = np.where(driving, 1.0 - i[:, None], 1.0 / (1.0 + i[:, None]))
+        v_t = eta_c - to_rim * np.cos(theta)
+        v_l = to_rim * np.abs(np.tan(beta))[:, None]
+        speed = np.hypot(v_t, v_l)
+        mobilised = strength * (1.0 - np.exp(-np.hypot(jx, jy) / k_x)) / np.where(speed > 0.0, speed, 1.0)
+        tau_x, tau_y = mobilised * v_t, mobilised * v_l
+    else:
+        tau_x = strength * (1.0 - np.exp(-jx / k_x))
+        tau_y = strength * (1.0 - np.exp(-jy / np.broadcast_to(shear_modulus_y, i.shape)[:, None]))
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
     grousers = bool(wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0)
     if grousers:
@@ -305,9 +334,6 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         fz = fz + soil.grouser_scale * gz
     if vertical_only:
         return {"vertical_force": fz}
-    jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
-    jy = jy * np.abs(np.tan(beta))[:, None]
-    tau_y = strength * (1.0 - np.exp(-jy / np.broadcast_to(shear_modulus_y, i.shape)[:, None]))
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)

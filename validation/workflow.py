@@ -13,6 +13,7 @@ from .calibration import normalised_residuals
 from .crossval import cross_validate, levels, write_cross_validation
 from .discovery import RESPONSES, discover, holdout_mask
 from .measured import Measurements, load_measurements, save_measurements
+from .terramechanics import SoilParameters
 from .model_file import load_model, save_model, write_predictions
 from .report import verdict_lines, write_report
 from .synthetic import HIDDEN_RANGES, draw_hidden_effect, synthetic_measurements
@@ -91,9 +92,12 @@ def test_errors(d, test: Measurements, *, seed: int = 0, bootstrap: int = 400) -
 
 
 def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
-             seed: int = 0, group: str | None = None, command: str = "", test: str | None = None) -> dict:
+             seed: int = 0, group: str | None = None, command: str = "", test: str | None = None,
+             shear_form: str = "independent") -> dict:
     """Load (or synthesise) the data, run discovery, write the report and ``model.json``; with ``test``, also
-    predict that second dataset with the model fitted on the first. Returns the findings dict."""
+    predict that second dataset with the model fitted on the first. ``shear_form``: the model's shear form
+    (:class:`~.terramechanics.SoilParameters`; "resultant" is the CMU lab's). Returns the findings dict."""
+    start = SoilParameters(shear_form=shear_form)  # refuses an unknown form before any work
     test_data = None
     if test is not None:  # read and check before any fitting
         if test in ("synthetic", "synthetic-periodic"):
@@ -122,8 +126,10 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
         title = f"Validation against {data.name}"
         name = params = None
     mask = parse_holdout(holdout, data, seed)
-    d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed)
-    extra = {"test": test_errors(d, test_data, seed=seed)} if test_data is not None else {}
+    d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed, start=start)
+    extra = {"shear_form": shear_form}
+    if test_data is not None:
+        extra["test"] = test_errors(d, test_data, seed=seed)
     md, _, findings = write_report(d, data, mask, report, title=title, command=command, excluded=excluded, extra=extra)
     save_model(report / "model.json", d, data.select(~mask), command=command)
     if data_arg == "synthetic":
@@ -137,11 +143,14 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
 
 
 def cross_validate_command(data_arg: str, by: str, *, report: Path, responses=None, group: str | None = None,
-                           seed: int = 0, command: str = "", progress=None) -> dict:
+                           seed: int = 0, command: str = "", progress=None, shear_form: str = "independent") -> dict:
     """``wheelsoil validate DATA --cv CONDITION``: leave each level of CONDITION out in turn (:mod:`.crossval`)."""
+    start = SoilParameters(shear_form=shear_form)
     data, default_responses, _ = _load_prepared(data_arg, group)
     levels(data, by)  # refuse a bad condition before any fitting
-    cv = cross_validate(data, by, responses=responses or default_responses, seed=seed, progress=progress)
+    cv = cross_validate(data, by, responses=responses or default_responses, seed=seed, progress=progress,
+                        start=start)
+    cv["shear_form"] = shear_form
     cv["report"] = str(write_cross_validation(cv, data, report, command=command))
     return cv
 
@@ -196,12 +205,13 @@ def main_validate(args) -> int:
                           f"(gain {fold['gain']:+.3f} +- {fold['gain_std']:.3f})", markup=False)
 
         cv = cross_validate_command(args.data, args.cv, report=args.report, responses=args.responses,
-                                    group=args.group, seed=args.seed, command=command, progress=show)
+                                    group=args.group, seed=args.seed, command=command, progress=show,
+                                    shear_form=args.shear_form)
         console.print(f"wrote {cv['report']}")
         return 0
     findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
                         hidden=args.hidden, seed=args.seed, group=args.group, command=command,
-                        test=getattr(args, "test", None))
+                        test=getattr(args, "test", None), shear_form=getattr(args, "shear_form", "independent"))
     base = findings["baseline"]
     console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out); "
                   f"final model: {findings['final']['heldout_rmse']:.3f} (held out)")
