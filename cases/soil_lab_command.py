@@ -37,6 +37,9 @@ def add_parser(sub) -> None:
     g.add_argument("--friction", type=float, default=p.static_friction, help="particle sliding friction [-]")
     g.add_argument("--rolling-friction", type=float, default=p.rolling_friction, help="rolling friction [-]")
     g.add_argument("--restitution", type=float, default=p.restitution, help="restitution [-]")
+    g.add_argument("--pour-friction-factor", type=float, default=1.0,
+                   help="sliding and rolling friction times this while the bed is poured: 1 a loose pour, 0 the "
+                        "densest [-]")
     g.add_argument("--gravity", type=gravity_argument, default=GRAVITY_PRESETS["earth"],
                    help="'earth', 'moon' or m/s^2 (the sand's tests: earth)")
     g.add_argument("--seeds", type=int, nargs="+", default=None,
@@ -75,7 +78,8 @@ def _bed_spec(args, box: dict, seed: int):
                           rolling_friction=args.rolling_friction)
     return BedSpec(length=box["length"], width=box["width"], depth=box["depth"], diameter_min=args.dmin,
                    diameter_max=args.dmax, gravity=(0.0, 0.0, -args.gravity), material=material, pair=pair,
-                   wall_material=soil_lab.TOOL_MATERIAL, wall_pair=soil_lab.TOOL_PAIR, seed=seed, periodic=False)
+                   wall_material=soil_lab.TOOL_MATERIAL, wall_pair=soil_lab.TOOL_PAIR, seed=seed, periodic=False,
+                   pour_friction_factor=args.pour_friction_factor)
 
 
 def _shear_envelope(path: Path | None) -> tuple[float | None, float]:

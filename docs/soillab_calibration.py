@@ -144,17 +144,21 @@ def summary(args) -> int:
     if not rows:
         print("no candidate finished yet")
         return 1
-    print("| sliding friction | rolling friction | density [kg/m^3] | repose [deg] | plate log-MSE | objective |")
-    print("|---|---|---|---|---|---|")
-    for r in sorted(rows, key=lambda r: (r["friction"], r["rolling_friction"])):
-        print(f"| {r['friction']:g} | {r['rolling_friction']:g} | {r['density']:.0f} | {r['repose_deg']:.1f} | "
+    print("| sliding friction | rolling friction | pour friction factor | packing fraction | density [kg/m^3] | "
+          "repose [deg] | shear: peak stress at 5 / 10 / 20 kPa [kPa] | plate log-MSE | objective |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in sorted(rows, key=lambda r: (r["friction"], r["rolling_friction"], -r.get("pour_friction_factor", 1.0))):
+        shear = " / ".join(f"{t / 1e3:.1f}" for t in r["shear"]["peak_shear_Pa"]) if "shear" in r else "-"
+        print(f"| {r['friction']:g} | {r['rolling_friction']:g} | {r.get('pour_friction_factor', 1.0):g} | "
+              f"{r['packing_fraction']:.3f} | {r['density']:.0f} | {r['repose_deg']:.1f} | {shear} | "
               f"{r['plate_log_mse']:.4f} | {r['objective']:.4f} |")
     best = min(rows, key=lambda r: r["objective"])
-    print(f"\nbest on the grid: sliding {best['friction']:g}, rolling {best['rolling_friction']:g} "
-          f"(objective {best['objective']:.4f}); {len(rows)} of {len(FRICTIONS) * len(ROLLING)} candidates done")
-    if len(rows) >= 6:
-        x = np.array([[r["friction"], r["rolling_friction"]] for r in rows])
-        y = np.array([r["objective"] for r in rows])
+    print(f"\nleast objective: sliding {best['friction']:g}, rolling {best['rolling_friction']:g}, pour friction factor "
+          f"{best.get('pour_friction_factor', 1.0):g} (objective {best['objective']:.4f}); {len(rows)} candidate(s) done")
+    grid = [r for r in rows if r.get("pour_friction_factor", 1.0) == 1.0]
+    if len(grid) >= 6:  # the friction grid's response surface
+        x = np.array([[r["friction"], r["rolling_friction"]] for r in grid])
+        y = np.array([r["objective"] for r in grid])
         basis = lambda p: np.c_[np.ones(len(p)), p, p**2, p[:, :1] * p[:, 1:]]  # noqa: E731
         coef, *_ = np.linalg.lstsq(basis(x), y, rcond=None)
         res = optimize.minimize(lambda p: float((basis(np.atleast_2d(p)) @ coef)[0]), x0=[best["friction"],

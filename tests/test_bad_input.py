@@ -96,3 +96,10 @@ def test_measured_files_the_model_cannot_use(change, needle, measured_dir, tmp_p
     path = tmp_path / "bad.csv"
     data.to_csv(path, index=False)
     _refused(["validate", str(path), "--report", str(tmp_path / "report")], capsys, needle)
+
+
+def test_a_pour_friction_factor_outside_zero_to_one_is_refused(tmp_path, capsys):
+    _refused(["soil-lab", "plate", "--pour-friction-factor", "2", "--out", str(tmp_path / "lab")], capsys,
+             "pour_friction_factor = 2.0", "0 <= pour_friction_factor <= 1")
+    _refused(["prepare-bed", "smoke-1g-steer", "--set", "soil.pour_friction_factor=-0.5", "--out",
+              str(tmp_path / "bed")], capsys, "soil.pour_friction_factor")

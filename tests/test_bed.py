@@ -58,7 +58,7 @@ def test_a_frictionless_pour_packs_denser_and_the_bed_keeps_its_friction(cache, 
     from wheelsoil.material import PairProperties
 
     rough = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.5)
-    base = dict(length=0.2, width=0.2, depth=0.1, diameter_min=0.012, diameter_max=0.018, periodic=False, seed=seed,
+    base = dict(length=0.15, width=0.15, depth=0.08, diameter_min=0.012, diameter_max=0.018, periodic=False, seed=seed,
                 pair=rough)
     loose = prepare_bed(BedSpec(**base), cache_dir=cache)
     dense = prepare_bed(BedSpec(**base, pour_friction_factor=0.0), cache_dir=cache)
