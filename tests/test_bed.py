@@ -49,6 +49,7 @@ def test_same_bed_is_reused_from_cache(cache):
     assert "pour_friction_factor" not in spec.to_dict()
 
 
+@pytest.mark.slow  # four beds of ~600 spheres, ~30 s
 @pytest.mark.parametrize("seed", [0, 1])
 def test_a_frictionless_pour_packs_denser_and_the_bed_keeps_its_friction(cache, seed):
     """Salot et al. (2009): the friction while the sample is made sets its density. Spheres with sliding and rolling

@@ -41,6 +41,12 @@ def test_cmu_trials_in_si(measured_dir):
     # slip along the heading: a turning wheel at 90 deg has slip 1, outside the driving branch
     assert set(np.unique(driving.slip_angle)) >= {0.0, 30.0, 60.0} and 90.0 not in driving.slip_angle
     assert np.all(driving.load > 0) and np.all(driving.radius == 0.058)
+    # the rows left out are counted by kind in the notes (the report prints them)
+    for w in ("grouser", "smooth"):
+        angles = _raw(os.path.join(folder, f"{w}_wheel_trials.csv"), "steering_angle_deg")
+        kept = int(np.sum(driving.group == w))
+        assert f"{w} wheel: {kept} of {len(angles)} rows kept" in driving.notes
+        assert f"{int(np.sum(angles == 90.0))} at 90 deg" in driving.notes.split(f"{w} wheel: ")[1]
 
 
 def test_digitised_points_in_si(measured_dir):

@@ -206,7 +206,15 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
         sinkage_relative=True,
     )
     if driving_only:
-        data = data.select((data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) < 90.0))
+        sideways = np.abs(data.slip_angle) >= 90.0
+        braking = ~sideways & (data.slip < 0.0)
+        keep = ~sideways & ~braking & (data.slip < 1.0)
+        counts = (f"{int(keep.sum())} of {n} rows kept: driving along the heading below 90 deg; left out: "
+                  f"{int(braking.sum())} braking along the heading (of them {int((braking & (data.slip <= -1.0)).sum())} "
+                  f"dragged), {int(sideways.sum())} at 90 deg, {int((~sideways & ~braking & ~keep).sum())} spinning "
+                  "in place")
+        data = data.select(keep)
+        data.notes = f"{data.notes}; {counts}"
     return data
 
 
@@ -222,7 +230,10 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
                                                     "grouser_height", "grouser_count", "group")),
         responses={q: np.concatenate([m.responses[q] for m in parts]) for q in parts[0].responses},
         std={q: np.concatenate([m.std[q] for m in parts]) for q in parts[0].std},
-        notes=parts[0].notes, sinkage_relative=True, passes=cat("passes"))
+        notes="; ".join([parts[0].notes.split("; ")[0], "sinkage zero is the wheel's start position"]
+                        + [f"{w} wheel: {m.notes.split('; ', 2)[2]}" for w, m in zip(("grouser", "smooth"), parts)
+                           if m.notes.count("; ") >= 2]),
+        sinkage_relative=True, passes=cat("passes"))
 
 
 def load_digitised(path: str | Path) -> Measurements:
