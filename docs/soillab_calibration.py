@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from wheelsoil.soillab.objective import SINKAGES, score
+from wheelsoil.soillab.objective import best as objective_best
 
 FRICTIONS = (0.3, 0.5, 0.7)
 ROLLING = (0.1, 0.25, 0.5)
@@ -103,7 +104,8 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
     if shear:
         result = soillab.shear_test(bed_spec, soillab.ShearSpec(), cache_dir=cache)
         row["shear"] = {"normal_stress_Pa": [r.plane_normal for r in result.runs],
-                        "peak_shear_Pa": [r.peak for r in result.runs], "dilation_m": [float(r.cap_rise[-1]) for r in result.runs],
+                        "peak_shear_Pa": [r.peak for r in result.runs],
+                        "dilation_m": [float(r.cap_rise[-1]) for r in result.runs],
                         "peak_friction_angle_deg": result.peak.friction_angle,
                         "peak_friction_angle_se_deg": result.peak.friction_angle_se,
                         "peak_cohesion_Pa": result.peak.cohesion, "peak_cohesion_se_Pa": result.peak.cohesion_se,
@@ -152,7 +154,7 @@ def summary(args) -> int:
         print(f"| {r['friction']:g} | {r['rolling_friction']:g} | {r.get('pour_friction_factor', 1.0):g} | "
               f"{r['packing_fraction']:.3f} | {r['density']:.0f} | {r['repose_deg']:.1f} | {shear} | "
               f"{r['plate_log_mse']:.4f} | {r['objective']:.4f} |")
-    best = min(rows, key=lambda r: r["objective"])
+    best = objective_best(rows)
     print(f"\nleast objective: sliding {best['friction']:g}, rolling {best['rolling_friction']:g}, pour friction factor "
           f"{best.get('pour_friction_factor', 1.0):g} (objective {best['objective']:.4f}); {len(rows)} candidate(s) done")
     grid = [r for r in rows if r.get("pour_friction_factor", 1.0) == 1.0]

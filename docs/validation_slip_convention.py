@@ -14,14 +14,13 @@ held out with seed 0 as in ``cmu-random-holdout``. The heading reading is the ri
 compares r omega with the carriage's speed V; the model's v_x is V cos beta), fixed from the kinematics, not from
 these results. The resultant shear form was added after the first two runs (classical form: the heading reading
 fitted worse, 0.819 against 0.522 held out) as the lab's own model (``tau_t.m``, ``tau_l.m``), unchanged from its
-source and without a free parameter, and run on both readings. The derived CSVs are written to a temporary folder, not to the repository (the data stay in
-``../shared``); the reports are in ``--out``.
+source and without a free parameter, and run on both readings. The derived CSVs are written to a temporary folder,
+not to the repository (the data stay in ``../shared``); the reports are in ``--out``.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 import tempfile
@@ -35,7 +34,7 @@ DATA = Path("..") / "shared" / "data" / "measured" / "cmu_3d_terramechanics"
 def main(argv=None) -> int:
     from wheelsoil.cases.cli import main as cli
     from wheelsoil.slip import heading_slip_from_travel
-    from wheelsoil.validation.measured import load_cmu_trials, save_measurements
+    from wheelsoil.validation.measured import load_cmu_trials, load_table, save_measurements
     from wheelsoil.validation.model_file import load_model
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -47,7 +46,7 @@ def main(argv=None) -> int:
 
     heading = load_cmu_trials(args.data, driving_only=False)
     # the rig's own slip column, in the loader's row order (grouser file, then smooth)
-    travel = np.concatenate([[float(r["slip"]) for r in csv.DictReader(open(Path(args.data) / f"{w}_wheel_trials.csv"))]
+    travel = np.concatenate([load_table(Path(args.data) / f"{w}_wheel_trials.csv").columns["slip"]
                              for w in ("grouser", "smooth")])
     if not np.allclose(heading_slip_from_travel(travel, heading.slip_angle), heading.slip):
         raise SystemExit("the trial files' rows are not in the loader's order")

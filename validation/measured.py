@@ -153,6 +153,8 @@ class Measurements:
 
 #: The columns of a CMU trial file (after the unit suffix is split off).
 CMU_COLUMNS = ("wheel", "steering_angle", "slip", "drawbar_pull", "lateral_force", "vertical_load", "sinkage")
+#: What every CMU dataset says of itself.
+CMU_NOTES = "Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position"
 
 
 def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurements:
@@ -202,38 +204,48 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
                    "sinkage": col("sinkage"), "torque": np.full(n, np.nan)},
         std={"drawbar_pull": opt("drawbar_pull_std"), "lateral_force": opt("lateral_force_std"),
              "vertical_load": opt("vertical_load_std")},
-        notes="Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position",
+        notes=CMU_NOTES,
         sinkage_relative=True,
     )
     if driving_only:
-        sideways = np.abs(data.slip_angle) >= 90.0
-        braking = ~sideways & (data.slip < 0.0)
-        keep = ~sideways & ~braking & (data.slip < 1.0)
-        counts = (f"{int(keep.sum())} of {n} rows kept: driving along the heading below 90 deg; left out: "
-                  f"{int(braking.sum())} braking along the heading (of them {int((braking & (data.slip <= -1.0)).sum())} "
-                  f"dragged), {int(sideways.sum())} at 90 deg, {int((~sideways & ~braking & ~keep).sum())} spinning "
-                  "in place")
+        keep, counts = _driving_rows(data)
         data = data.select(keep)
-        data.notes = f"{data.notes}; {counts}"
+        data.notes = f"{CMU_NOTES}; {counts}"
     return data
+
+
+def _driving_rows(data: Measurements) -> tuple[np.ndarray, str]:
+    """The rows on the model's driving branch (0 <= slip < 1 along the heading, below 90 deg) and a sentence counting
+    the rows left out, by kind."""
+    sideways = np.abs(data.slip_angle) >= 90.0
+    braking = ~sideways & (data.slip < 0.0)
+    keep = ~sideways & ~braking & (data.slip < 1.0)
+    counts = (f"{int(keep.sum())} of {len(data)} rows kept: driving along the heading below 90 deg; left out: "
+              f"{int(braking.sum())} braking along the heading (of them {int((braking & (data.slip <= -1.0)).sum())} "
+              f"dragged), {int(sideways.sum())} at 90 deg, {int((~sideways & ~braking & ~keep).sum())} spinning "
+              "in place")
+    return keep, counts
 
 
 def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
     """The CMU 3D-terramechanics trials of a folder: both wheels' files (``grouser_wheel_trials.csv``,
     ``smooth_wheel_trials.csv``) read by :func:`load_cmu_file` into one set."""
     folder = Path(folder)
-    parts = [load_cmu_file(folder / f"{wheel}_wheel_trials.csv", driving_only=driving_only)
-             for wheel in ("grouser", "smooth")]
+    parts, notes = [], [CMU_NOTES]
+    for wheel in ("grouser", "smooth"):
+        part = load_cmu_file(folder / f"{wheel}_wheel_trials.csv", driving_only=False)
+        if driving_only:
+            keep, counts = _driving_rows(part)
+            part = part.select(keep)
+            notes.append(f"{wheel} wheel: {counts}")
+        parts.append(part)
     cat = lambda key: np.concatenate([getattr(m, key) for m in parts])  # noqa: E731
     return Measurements(
         "cmu_3d_terramechanics", *(cat(k) for k in ("slip", "slip_angle", "load", "gravity", "radius", "width",
                                                     "grouser_height", "grouser_count", "group")),
         responses={q: np.concatenate([m.responses[q] for m in parts]) for q in parts[0].responses},
         std={q: np.concatenate([m.std[q] for m in parts]) for q in parts[0].std},
-        notes="; ".join([parts[0].notes.split("; ")[0], "sinkage zero is the wheel's start position"]
-                        + [f"{w} wheel: {m.notes.split('; ', 2)[2]}" for w, m in zip(("grouser", "smooth"), parts)
-                           if m.notes.count("; ") >= 2]),
-        sinkage_relative=True, passes=cat("passes"))
+        notes="; ".join(notes), sinkage_relative=True, passes=cat("passes"))
 
 
 def load_digitised(path: str | Path) -> Measurements:

@@ -312,9 +312,13 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
                   r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
     k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
-    jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
-    jy = jy * np.abs(np.tan(beta))[:, None]
-    if soil.shear_form == "resultant":
+
+    def lateral_displacement():  # seed 003 eq. 16
+        jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
+        return jy * np.abs(np.tan(beta))[:, None]
+
+    resultant = soil.shear_form == "resultant"
+    if resultant:
         # the slip velocity under the rim in units of r omega (v_jt.m; v_x = (1 - i) r omega driving,
         # r omega / (1 + i) braking): its direction shares the strength the resultant displacement mobilises
         eta_c = (1.0 - eta)[:, None]
@@ -322,11 +326,11 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         v_t = eta_c - to_rim * np.cos(theta)
         v_l = to_rim * np.abs(np.tan(beta))[:, None]
         speed = np.hypot(v_t, v_l)
-        mobilised = strength * (1.0 - np.exp(-np.hypot(jx, jy) / k_x)) / np.where(speed > 0.0, speed, 1.0)
+        mobilised = (strength * (1.0 - np.exp(-np.hypot(jx, lateral_displacement()) / k_x))
+                     / np.where(speed > 0.0, speed, 1.0))
         tau_x, tau_y = mobilised * v_t, mobilised * v_l
     else:
         tau_x = strength * (1.0 - np.exp(-jx / k_x))
-        tau_y = strength * (1.0 - np.exp(-jy / np.broadcast_to(shear_modulus_y, i.shape)[:, None]))
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
     grousers = bool(wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0)
     if grousers:
@@ -334,6 +338,9 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         fz = fz + soil.grouser_scale * gz
     if vertical_only:
         return {"vertical_force": fz}
+    if not resultant:  # the lateral shear is not needed for the sinkage solve
+        shear_modulus_y = np.broadcast_to(shear_modulus_y, i.shape)[:, None]
+        tau_y = strength * (1.0 - np.exp(-lateral_displacement() / shear_modulus_y))
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
