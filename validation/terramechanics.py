@@ -319,16 +319,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
 
     resultant = soil.shear_form == "resultant"
     if resultant:
-        # the slip velocity under the rim in units of r omega (v_jt.m; v_x = (1 - i) r omega driving,
-        # r omega / (1 + i) braking): its direction shares the strength the resultant displacement mobilises
-        eta_c = (1.0 - eta)[:, None]
-        to_rim = np.where(driving, 1.0 - i[:, None], 1.0 / (1.0 + i[:, None]))
-        v_t = eta_c - to_rim * np.cos(theta)
-        v_l = to_rim * np.abs(np.tan(beta))[:, None]
-        speed = np.hypot(v_t, v_l)
-        mobilised = (strength * (1.0 - np.exp(-np.hypot(jx, lateral_displacement()) / k_x))
-                     / np.where(speed > 0.0, speed, 1.0))
-        tau_x, tau_y = mobilised * v_t, mobilised * v_l
+        tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(), k_x, i, beta, eta, theta)
     else:
         tau_x = strength * (1.0 - np.exp(-jx / k_x))
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
@@ -361,6 +352,20 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         "theta_m": theta_m,
         "theta_r": theta_r,
     }
+
+
+def resultant_shear(strength, jx, jy, k_x, slip, beta, soil_flow, theta):
+    """The CMU lab's shear (``tau_t.m``, ``tau_l.m``; module docstring): strength [Pa] mobilised by sqrt(j_x^2 +
+    j_y^2) / k_x [m / m] along the slip velocity. Rows: conditions (slip, beta [rad], soil flow eta); columns: theta
+    [rad]. Returns (tau_x, tau_y) [Pa], tau_y a magnitude (its sign is -sign(beta))."""
+    i = slip[:, None]
+    # the slip velocity in units of r omega (v_jt.m): v_x = (1 - i) r omega driving, r omega / (1 + i) braking
+    to_rim = np.where(i >= 0.0, 1.0 - i, 1.0 / (1.0 + i))
+    v_t = (1.0 - soil_flow)[:, None] - to_rim * np.cos(theta)
+    v_l = to_rim * np.abs(np.tan(beta))[:, None]
+    speed = np.hypot(v_t, v_l)
+    mobilised = strength * (1.0 - np.exp(-np.hypot(jx, jy) / k_x)) / np.where(speed > 0.0, speed, 1.0)
+    return mobilised * v_t, mobilised * v_l
 
 
 def bearing_capacity_factors(friction_angle_deg: float) -> tuple[float, float, float]:
