@@ -22,7 +22,7 @@ from wheelsoil.coupling.testbed import TestbedSpec
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, preset
 from wheelsoil.granular.bed import BedSpec
 from wheelsoil.material import Material, PairProperties
-from wheelsoil.parameters import smoke
+from wheelsoil.parameters import seed004, smoke
 
 if TYPE_CHECKING:  # type hints only: the schema imports this module
     from .schema import CaseFile
@@ -40,7 +40,8 @@ def bed_spec(case: CaseFile) -> BedSpec:
         length=s.length, width=s.width, depth=s.depth, diameter_min=s.diameter_min,
         diameter_max=s.diameter_max, gravity=s.gravity_vector,
         material=Material(smoke.SOIL_MATERIAL.name, s.youngs_modulus, s.poisson_ratio, s.density),
-        pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction),
+        pair=PairProperties(s.restitution, s.static_friction, s.rolling_friction, s.rolling_model),
+        wall_pair=replace(seed004.SOIL_STEEL, rolling_model=s.rolling_model),
         seed=case.case.seed, max_settle_time=s.max_settle_time, periodic=s.periodic,
         pour_friction_factor=s.pour_friction_factor,
     )
@@ -76,7 +77,7 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
         sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
         steady_checks=o.steady_checks, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
         damping=case.wheel.damping, axle_damping=t.axle_damping,
-        pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction),
+        pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction, case.soil.rolling_model),
     )
 
 

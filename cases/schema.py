@@ -127,6 +127,11 @@ class Soil(_Section):
     pour_friction_factor: float = _q(1.0, "1", "sliding and rolling friction are multiplied by this while the bed is "
                                      "poured: 1 a loose pour, 0 frictionless spheres, the densest bed; the run uses "
                                      "the friction above", _BED["pour_friction_factor"])
+    rolling_model: Literal["cdt", "epsd"] = Field(
+        "cdt", description="the rolling-resistance law of every soil contact (soil--soil, bin walls, wheel): 'cdt' "
+                           "constant directional torque, or 'epsd' elastic--plastic spring--dashpot, which holds a "
+                           "torque below mu_r F_n R* at rest (CDT creeps under it at a rate proportional to the time "
+                           "step); formulas in wheelsoil.granular.contact")
 
     @field_validator("gravity")
     @classmethod
@@ -300,6 +305,8 @@ class CaseFile(BaseModel):
             data["test"].pop("slip_speed")
         if data["soil"]["pour_friction_factor"] == 1.0:
             data["soil"].pop("pour_friction_factor")
+        if data["soil"]["rolling_model"] == "cdt":
+            data["soil"].pop("rolling_model")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 

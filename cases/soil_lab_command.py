@@ -10,11 +10,13 @@ stress the contact cannot carry, a measured file without its columns) is refused
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import GRAVITY_PRESETS
+from wheelsoil.material import PairProperties
 from wheelsoil.parameters import soil_lab
 
 from .units import gravity_argument
@@ -37,6 +39,9 @@ def add_parser(sub) -> None:
     g.add_argument("--friction", type=float, default=p.static_friction, help="particle sliding friction [-]")
     g.add_argument("--rolling-friction", type=float, default=p.rolling_friction, help="rolling friction [-]")
     g.add_argument("--restitution", type=float, default=p.restitution, help="restitution [-]")
+    g.add_argument("--rolling-model", choices=PairProperties.ROLLING_MODELS, default=p.rolling_model,
+                   help="rolling-resistance law of every soil contact (particles, box, plates): cdt (constant "
+                        "directional torque) or epsd (elastic-plastic spring-dashpot, holds a torque at rest)")
     g.add_argument("--pour-friction-factor", type=float, default=1.0,
                    help="sliding and rolling friction times this while the bed is poured: 1 a loose pour, 0 the "
                         "densest [-]")
@@ -70,15 +75,17 @@ def add_parser(sub) -> None:
 
 def _bed_spec(args, box: dict, seed: int):
     from wheelsoil.granular.bed import BedSpec
-    from wheelsoil.material import Material, PairProperties
+    from wheelsoil.material import Material
 
     material = Material("soil-lab particles", youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
                         density=args.density)
     pair = PairProperties(restitution=args.restitution, static_friction=args.friction,
-                          rolling_friction=args.rolling_friction)
+                          rolling_friction=args.rolling_friction, rolling_model=args.rolling_model)
     return BedSpec(length=box["length"], width=box["width"], depth=box["depth"], diameter_min=args.dmin,
                    diameter_max=args.dmax, gravity=(0.0, 0.0, -args.gravity), material=material, pair=pair,
-                   wall_material=soil_lab.TOOL_MATERIAL, wall_pair=soil_lab.TOOL_PAIR, seed=seed, periodic=False,
+                   wall_material=soil_lab.TOOL_MATERIAL,
+                   wall_pair=dataclasses.replace(soil_lab.TOOL_PAIR, rolling_model=args.rolling_model), seed=seed,
+                   periodic=False,
                    pour_friction_factor=args.pour_friction_factor)
 
 

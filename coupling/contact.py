@@ -56,6 +56,7 @@ from wheelsoil.granular.materials import (
     effective_modulus,
     effective_shear_modulus,
 )
+from wheelsoil.granular.contact import ROLLING_MODELS
 from wheelsoil.granular.scene import Interaction, Scene
 from wheelsoil.granular.neighbors import exclusive_scan
 from wheelsoil.taichi_types import ivec3, vec3
@@ -67,6 +68,9 @@ from .surface import ContactSurface
 #: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
 #: or two places in practice: a face, or the corner between the tread and a grouser).
 HISTORY_SLOTS = 4
+#: The per-particle contact history arrays: contact normals, tangential displacements [m], rolling spring torques
+#: [N m] (EPSD pairs; zero under CDT) and the number of slots in use.
+HISTORY_KEYS = ("hist_n", "hist_xi", "hist_roll", "hist_count")
 
 
 class WheelContact(Interaction):
@@ -167,6 +171,7 @@ class WheelContact(Interaction):
         a["active"] = ti.ndarray(ti.i32, shape=n)
         a["hist_n"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
         a["hist_xi"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
+        a["hist_roll"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
         a["hist_count"] = ti.ndarray(ti.i32, shape=n)
         a["hist_count"].fill(0)
         self._scene_key = (id(scene), n)
@@ -203,7 +208,7 @@ class WheelContact(Interaction):
         self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, self._facet_start,
                                         self._facet_fill, facet_entries)
         for name, dtype in (("code", ti.i32), ("keep", ti.i32), ("overlap", ti.f64), ("stiffness", ti.f64), ("normal", vec3),
-                            ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3)):
+                            ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3), ("roll_new", vec3)):
             self._buffer(name, dtype, max(n_cand, 1))
         self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
         self._arrays["keep"].fill(0)
@@ -243,7 +248,8 @@ class WheelContact(Interaction):
             self._contact_arrays = (
                 (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
                 (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
-                 a["f_wheel"], a["m_wheel"], a["xi_new"], a["stiffness"], a["hist_n"], a["hist_xi"], a["hist_count"],
+                 a["f_wheel"], a["m_wheel"], a["xi_new"], a["roll_new"], a["stiffness"], a["hist_n"], a["hist_xi"],
+                 a["hist_roll"], a["hist_count"],
                  w.x, w.v, w.w, self._inv_mass, self._tri, self._edges, self._half_t,
                  self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
                  w.f_ext, w.k_ext, w.x_anchor, self._node_ref, w.hub, self._resultant),
@@ -252,7 +258,7 @@ class WheelContact(Interaction):
         k.wheel_contacts_graph(
             *particles, self._n_active, *rest,
             self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
-            dt, self._stats,
+            ROLLING_MODELS[self.pair.rolling_model], dt, self._stats,
         )
 
     # ------------------------------------------------------------------ measured quantities
@@ -286,7 +292,7 @@ class WheelContact(Interaction):
         out = {key: getattr(self, key) for key in self._STATE_SCALARS}
         out["resultant"] = self._resultant.to_numpy()
         if self._arrays:
-            for key in ("hist_n", "hist_xi", "hist_count"):
+            for key in HISTORY_KEYS:
                 out[key] = self._arrays[key].to_numpy()
         return out
 
@@ -295,7 +301,7 @@ class WheelContact(Interaction):
         carry each sphere's contact history to its new index (called by the scene)."""
         if not self._arrays or self._scene_key is None:
             return
-        old = {key: self._arrays[key].to_numpy() for key in ("hist_n", "hist_xi", "hist_count")}
+        old = {key: self._arrays[key].to_numpy() for key in HISTORY_KEYS}
         self._attach(scene)
         keep = old_of_new >= 0
         for key, values in old.items():
@@ -314,7 +320,9 @@ class WheelContact(Interaction):
         self._resultant.from_numpy(np.asarray(state["resultant"], float))
         if "hist_count" in state:
             self._attach(scene)
-            for key in ("hist_n", "hist_xi", "hist_count"):
+            if "hist_roll" not in state:  # a checkpoint from before the rolling history existed
+                state = {**state, "hist_roll": np.zeros_like(state["hist_xi"])}
+            for key in HISTORY_KEYS:
                 if tuple(np.shape(state[key])[:1]) != (scene.n_particles,):
                     raise WheelsoilInputError(f"the saved contact history {key!r} is for another number of particles")
                 self._arrays[key].from_numpy(np.ascontiguousarray(state[key]))

@@ -305,15 +305,15 @@ def wheel_contacts(
     n_active: ti.i32, active: nd_i32, start: nd_i32, cand: nd_i32,
     # per-entry scratch
     code: nd_i32, keep: nd_i32, bary: nd_f64_2d, normal: nd_vec3, overlap: nd_f64, f_wheel: nd_vec3,
-    m_wheel: nd_vec3, xi_new: nd_vec3, stiffness: nd_f64,
+    m_wheel: nd_vec3, xi_new: nd_vec3, roll_new: nd_vec3, stiffness: nd_f64,
     # contact history per particle
-    hist_n: nd_vec3_2d, hist_xi: nd_vec3_2d, hist_count: nd_i32,
+    hist_n: nd_vec3_2d, hist_xi: nd_vec3_2d, hist_roll: nd_vec3_2d, hist_count: nd_i32,
     # wheel
     xw: nd_vec3, vw: nd_vec3, ww: nd_vec3, inv_mass_w: nd_f64, tri: nd_i32_2d, edges: nd_i32_2d, half_t: nd_f64,
     nodes: nd_i32, corner_start: nd_i32, corners: nd_i32, facet_start: nd_i32, facet_entries: nd_i32,
     f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, node_ref: nd_vec3, hub: nd_vec3, resultant: nd_vec3,
     # contact law
-    e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, dt: ti.f64,
+    e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, rolling: ti.i32, dt: ti.f64,
     stats: nd_f64,
 ):
     """One evaluation of every particle--wheel contact (phases A--D above, then the resultant).
@@ -346,9 +346,11 @@ def wheel_contacts(
                 depth = overlap[e]
                 best = matched_history(i, n, ti.cast(code[e] == FACE, ti.i32), n_old, claimed, hist_n)
                 xi = vec3(0.0)
+                roll = vec3(0.0)
                 if best >= 0:
                     claimed |= 1 << best
                     xi = hist_xi[i, best]
+                    roll = hist_roll[i, best]
                     if code[e] == FACE and n.dot(hist_n[i, best]) < 0.0:
                         # the contact stays on the side of the shell it began on (no tunnelling)
                         n = -n
@@ -366,9 +368,9 @@ def wheel_contacts(
                 # at c moves the lumped nodes by b_k F / m_k, so 1/m_c = sum b_k^2 / m_k (tied nodes: 0)
                 inv_mc = b0 * b0 * inv_mass_w[i0] + b1 * b1 * inv_mass_w[i1] + b2 * b2 * inv_mass_w[i2]
                 m_eff = 1.0 / (1.0 / mass[i] + inv_mc)
-                fc, tn, m_roll, xi_out = hertz_mindlin(
+                fc, tn, m_roll, xi_out, roll_out = hertz_mindlin(
                     n, depth, v[i] + omega[i].cross(ri * n) - v_wheel, omega[i] - w_wheel,
-                    ri, m_eff, inertia[i], e_eff, g_eff, beta, mu_s, mu_r, xi, dt,
+                    ri, m_eff, inertia[i], e_eff, g_eff, beta, mu_s, mu_r, rolling, xi, roll, dt,
                 )
                 f_total += fc
                 t_total += ri * tn + m_roll
@@ -381,6 +383,7 @@ def wheel_contacts(
                 m_wheel[e] = facet_moment_forces(s, xw, tri, -m_roll - (p + ri * n - point).cross(fc))
                 normal[e] = n
                 xi_new[e] = xi_out
+                roll_new[e] = roll_out
                 n_kept += 1
         n_contacts += n_kept
         # the history of this step's contacts
@@ -389,6 +392,7 @@ def wheel_contacts(
             if keep[e] and slots < hist_n.shape[1]:
                 hist_n[i, slots] = normal[e]
                 hist_xi[i, slots] = xi_new[e]
+                hist_roll[i, slots] = roll_new[e]
                 slots += 1
         hist_count[i] = slots
         ext_force[i] += f_total

@@ -47,7 +47,9 @@ from .scene import Scene
 #: 2: spheres in column order (:mod:`.ordering`) from the lattice on.
 #: 3: the settled bed keeps its tangential contact history (pairs and walls), so a scene made from it starts
 #:    in the prepared equilibrium instead of re-seating (friction-held spheres slipping until it rebuilds).
-BED_FORMAT_VERSION = 3
+#: 4: a pair whose owner changes in the column renumbering keeps its history's direction (format 3 stored the
+#:    displacement of such pairs with the wrong sign), and the rolling spring torques are kept as well.
+BED_FORMAT_VERSION = 4
 
 
 class BedNotSettledError(SimulationUnstableError):
@@ -157,6 +159,7 @@ class BedSpec:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["gravity"] = list(self.gravity)
+        d["pair"], d["wall_pair"] = self.pair.to_dict(), self.wall_pair.to_dict()
         if not self.periodic:  # beds prepared before periodic bins existed keep their cache keys
             d.pop("periodic")
         if self.pour_friction_factor == 1.0:  # and so do loose pours, made before the factor existed
@@ -172,7 +175,9 @@ class BedSpec:
 
     @classmethod
     def from_dict(cls, d: dict) -> BedSpec:
-        d = dict(d)
+        # the keys :meth:`to_dict` leaves out at their old value (a walled bin, a loose pour) mean that value, not
+        # the current default (a periodic bin): a walled bed read back from the cache stays walled
+        d = {"periodic": False, "pour_friction_factor": 1.0, **d}
         d["material"] = Material(**d["material"])
         d["pair"] = PairProperties(**d["pair"])
         d["wall_material"] = None if d.get("wall_material") is None else Material(**d["wall_material"])
@@ -298,25 +303,31 @@ class Bed:
             x = x.copy()
             x[:, 0] = np.mod(x[:, 0], s.length)
         scene.add_spheres(x, self.radii, self.velocities, self.angular_velocities,
-                          wall_history=self._wall_history(scene))
-        if self.history is not None and len(self.history["pair_i"]):
-            scene.set_contact_history(self.history["pair_i"], self.history["pair_j"], self.history["pair_xi"])
+                          wall_history=self._wall_history(scene, "xi_wall"),
+                          wall_roll_history=self._wall_history(scene, "roll_wall"))
+        self.set_pair_history(scene)
         if s.time_step is not None:
             scene.time_step = s.time_step
         return scene
 
 
-    def _wall_history(self, scene: Scene) -> np.ndarray | None:
-        """The bed's wall history in the columns of ``scene``'s walls (matched by point and normal; zero for a
-        wall the bed had not)."""
+    def set_pair_history(self, scene: Scene) -> None:
+        """Give ``scene``'s spheres (this bed's, in its order) the bed's pair contact history."""
         h = self.history
-        if h is None or "xi_wall" not in h:
+        if h is not None and len(h["pair_i"]):
+            scene.set_contact_history(h["pair_i"], h["pair_j"], h["pair_xi"], h.get("pair_roll"))
+
+    def _wall_history(self, scene: Scene, key: str) -> np.ndarray | None:
+        """The bed's wall history ``key`` (``xi_wall`` or ``roll_wall``) in the columns of ``scene``'s walls (matched
+        by point and normal; zero for a wall the bed had not)."""
+        h = self.history
+        if h is None or key not in h:
             return None
         out = np.zeros((self.n_particles, len(scene.walls), 3))
         for k, wall in enumerate(scene.walls):
             for b, (point, normal) in enumerate(zip(h["wall_point"], h["wall_normal"])):
                 if np.allclose(normal, wall.normal) and abs(np.dot(np.asarray(wall.point) - point, normal)) < 1e-12:
-                    out[:, k] = h["xi_wall"][:, b]
+                    out[:, k] = h[key][:, b]
         return out
 
 
@@ -536,16 +547,7 @@ def prepare_bed(
     if spec.periodic:
         x[:, 0] = np.mod(x[:, 0], spec.length)
     surface = measure_surface(x, r, spec)
-    # the contact history, renumbered to the column order
-    hist = scene.contact_history()
-    new_index = np.empty(len(order), np.int64)
-    new_index[order] = np.arange(len(order))
-    pi, pj = new_index[hist["pair_i"]], new_index[hist["pair_j"]]
-    touching = np.any(hist["pair_xi"] != 0.0, axis=1)
-    pi, pj, pxi = np.minimum(pi, pj)[touching], np.maximum(pi, pj)[touching], hist["pair_xi"][touching]
-    srt = np.lexsort((pj, pi))
-    history = {"pair_i": pi[srt].astype(np.int32), "pair_j": pj[srt].astype(np.int32), "pair_xi": pxi[srt],
-               "xi_wall": hist["xi_wall"][order],
+    history = {**history_in_order(scene.contact_history(), order),
                "wall_point": np.array([w.point for w in scene.walls]), "wall_normal": np.array([w.normal for w in scene.walls])}
     bed = Bed(
         spec=spec,
@@ -563,6 +565,24 @@ def prepare_bed(
         bed.save(path)
     bed.meta.update(cache_path=str(path) if use_cache else "", from_cache=False)
     return bed
+
+
+def history_in_order(hist: dict, order: np.ndarray) -> dict:
+    """The touching pairs and the wall contacts of a contact history (``Scene.contact_history``) with the spheres
+    renumbered so that new sphere k is old sphere ``order[k]``.
+
+    A pair is owned by its lower index and its displacement and rolling torque are as the owner sees them, so a pair
+    whose two spheres swap order is turned around: both are negated."""
+    new_index = np.empty(len(order), np.int64)
+    new_index[order] = np.arange(len(order))
+    pi, pj = new_index[hist["pair_i"]], new_index[hist["pair_j"]]
+    touching = np.any((hist["pair_xi"] != 0.0) | (hist["pair_roll"] != 0.0), axis=1)
+    sign = np.where(pi > pj, -1.0, 1.0)[:, None]
+    pi, pj = np.minimum(pi, pj)[touching], np.maximum(pi, pj)[touching]
+    srt = np.lexsort((pj, pi))
+    return {"pair_i": pi[srt].astype(np.int32), "pair_j": pj[srt].astype(np.int32),
+            **{key: (sign * hist[key])[touching][srt] for key in ("pair_xi", "pair_roll")},
+            **{key: hist[key][order] for key in ("xi_wall", "roll_wall")}}
 
 
 def load_bed(path: str | Path) -> Bed:

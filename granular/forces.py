@@ -33,13 +33,14 @@ import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
 
-from .contact import hertz_mindlin
+from .contact import ROLLING_EPSD, hertz_mindlin
 from .neighbors import mat23, nd_f64, nearest_image, nd_i32, nd_mat23, nd_vec3, nd_vec3_2d, nd_vec4, vec3
 
 nd_f64_2d = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
-#: Column layout of the per-wall property table (``wall_props[w, :]``).
-WALL_E_EFF, WALL_G_EFF, WALL_BETA, WALL_MU_S, WALL_MU_R = range(5)
+#: Column layout of the per-wall property table (``wall_props[w, :]``); WALL_ROLLING holds the rolling law's code
+#: (:data:`.contact.ROLLING_MODELS`) as a float.
+WALL_E_EFF, WALL_G_EFF, WALL_BETA, WALL_MU_S, WALL_MU_R, WALL_ROLLING = range(6)
 
 
 @ti.func
@@ -51,6 +52,7 @@ def owner_contacts(
     pair_start: ti.template(),
     pair_j: ti.template(),
     pair_xi: ti.template(),
+    pair_roll: ti.template(),
     pair_rev: ti.template(),
     touching_flag: ti.template(),
     partner_slot: ti.template(),
@@ -58,6 +60,7 @@ def owner_contacts(
     wall_normal: ti.template(),
     wall_props: ti.template(),
     xi_wall: ti.template(),
+    roll_wall: ti.template(),
     wall_touching: ti.template(),
     wall_near: ti.template(),
     e_eff,
@@ -65,6 +68,7 @@ def owner_contacts(
     beta,
     mu_s,
     mu_r,
+    rolling,
     dt,
     period,
     inv_period,
@@ -78,7 +82,9 @@ def owner_contacts(
     mask of the walls particle i touched at the last step, so a wall history is cleared once on
     separation rather than every step; ``wall_near[i]`` the mask of the walls within reach since
     the last rebuild (:func:`.neighbors.near_walls`). Only walls in either mask are checked: most
-    particles of a bed are far from every wall and skip the loop. ``period``, ``inv_period``: the
+    particles of a bed are far from every wall and skip the loop. ``pair_roll``, ``roll_wall``: the rolling
+    history [N m] (the EPSD spring torque), read and written only by contacts under that law (``rolling``, or the
+    wall's ``WALL_ROLLING`` column), so the default law costs no memory traffic for it. ``period``, ``inv_period``: the
     periodic length along x and its inverse (0 and 0 without periodicity; :func:`.neighbors.nearest_image`).
     """
     own_x = x_r[i]
@@ -108,7 +114,10 @@ def owner_contacts(
             mj = other_v[3]
             ij = other_w[3]
             wj = other_w.xyz
-            fc, tn, m_roll, xi_new = hertz_mindlin(
+            roll = vec3(0.0, 0.0, 0.0)
+            if rolling == ROLLING_EPSD:
+                roll = pair_roll[p]
+            fc, tn, m_roll, xi_new, roll_new = hertz_mindlin(
                 n,
                 reach - dist,
                 vi + wi.cross(ri * n) - (other_v.xyz + wj.cross(-rj * n)),
@@ -121,10 +130,14 @@ def owner_contacts(
                 beta,
                 mu_s,
                 mu_r,
+                rolling,
                 pair_xi[p],
+                roll,
                 dt,
             )
             pair_xi[p] = xi_new
+            if rolling == ROLLING_EPSD:
+                pair_roll[p] = roll_new
             f += fc
             t += ri * tn + m_roll
             tj = rj * tn - m_roll
@@ -134,6 +147,8 @@ def owner_contacts(
         elif touching_flag[p] != 0:
             touching_flag[p] = 0
             pair_xi[p] = vec3(0.0, 0.0, 0.0)
+            if rolling == ROLLING_EPSD:
+                pair_roll[p] = vec3(0.0, 0.0, 0.0)
             partner_slot[pair_rev[p]] = mat23([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
     mask = wall_touching[i]
     candidates = mask | wall_near[i]
@@ -145,9 +160,13 @@ def owner_contacts(
         if (candidates >> w) & 1:
             nw = wall_normal[w]
             gap = (xi_pos - wall_point[w]).dot(nw)
+            wall_rolling = ti.cast(wall_props[w, WALL_ROLLING], ti.i32)
             if gap < ri:
                 n = -nw
-                fc, tw, m_roll, xi_new = hertz_mindlin(
+                roll = vec3(0.0, 0.0, 0.0)
+                if wall_rolling == ROLLING_EPSD:
+                    roll = roll_wall[i, w]
+                fc, tw, m_roll, xi_new, roll_new = hertz_mindlin(
                     n,
                     ri - gap,
                     vi + wi.cross(ri * n),
@@ -160,16 +179,21 @@ def owner_contacts(
                     wall_props[w, WALL_BETA],
                     wall_props[w, WALL_MU_S],
                     wall_props[w, WALL_MU_R],
+                    wall_rolling,
                     xi_wall[i, w],
+                    roll,
                     dt,
                 )
                 xi_wall[i, w] = xi_new
+                if wall_rolling == ROLLING_EPSD:
+                    roll_wall[i, w] = roll_new
                 f += fc
                 t += ri * tw + m_roll
                 n_contacts += 1
                 new_mask |= 1 << w
             elif (mask >> w) & 1:
                 xi_wall[i, w] = vec3(0.0, 0.0, 0.0)
+                roll_wall[i, w] = vec3(0.0, 0.0, 0.0)
     if new_mask != mask:
         wall_touching[i] = new_mask
     return f, t, n_contacts
@@ -206,6 +230,7 @@ def contact_forces(
     pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
+    pair_roll: nd_vec3,
     pair_rev: nd_i32,
     touching_flag: nd_i32,
     partner_slot: nd_mat23,
@@ -214,6 +239,7 @@ def contact_forces(
     wall_normal: nd_vec3,
     wall_props: nd_f64_2d,
     xi_wall: nd_vec3_2d,
+    roll_wall: nd_vec3_2d,
     wall_touching: nd_i32,
     wall_near: nd_i32,
     e_eff: ti.f64,
@@ -221,6 +247,7 @@ def contact_forces(
     beta: ti.f64,
     mu_s: ti.f64,
     mu_r: ti.f64,
+    rolling: ti.i32,
     dt: ti.f64,
     period: ti.f64,
     inv_period: ti.f64,
@@ -241,9 +268,9 @@ def contact_forces(
     n_contacts = 0
     for i in x_r:
         f, t, n = owner_contacts(
-            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
-            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
-            e_eff, g_eff, beta, mu_s, mu_r, dt, period, inv_period,
+            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_roll, pair_rev, touching_flag,
+            partner_slot, wall_point, wall_normal, wall_props, xi_wall, roll_wall, wall_touching, wall_near,
+            e_eff, g_eff, beta, mu_s, mu_r, rolling, dt, period, inv_period,
         )
         force[i] = f
         torque[i] = t

@@ -40,6 +40,7 @@ def contact_step(
     pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
+    pair_roll: nd_vec3,
     pair_rev: nd_i32,
     touching_flag: nd_i32,
     partner_slot: nd_mat23,
@@ -48,6 +49,7 @@ def contact_step(
     wall_normal: nd_vec3,
     wall_props: nd_f64_2d,
     xi_wall: nd_vec3_2d,
+    roll_wall: nd_vec3_2d,
     wall_touching: nd_i32,
     wall_near: nd_i32,
     e_eff: ti.f64,
@@ -55,6 +57,7 @@ def contact_step(
     beta: ti.f64,
     mu_s: ti.f64,
     mu_r: ti.f64,
+    rolling: ti.i32,
     dt: ti.f64,
     period: ti.f64,
     inv_period: ti.f64,
@@ -82,9 +85,9 @@ def contact_step(
     n_contacts = 0
     for i in x:
         f, t, n = owner_contacts(
-            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_rev, touching_flag,
-            partner_slot, wall_point, wall_normal, wall_props, xi_wall, wall_touching, wall_near,
-            e_eff, g_eff, beta, mu_s, mu_r, dt, period, inv_period,
+            i, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_roll, pair_rev, touching_flag,
+            partner_slot, wall_point, wall_normal, wall_props, xi_wall, roll_wall, wall_touching, wall_near,
+            e_eff, g_eff, beta, mu_s, mu_r, rolling, dt, period, inv_period,
         )
         force[i] = f
         torque[i] = t

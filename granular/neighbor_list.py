@@ -1,5 +1,5 @@
 """The neighbour list of a scene: the grid its spheres are binned in, the Verlet rows, and the compact pair list
-that carries each pair's tangential contact history (the kernels are in :mod:`.neighbors`).
+that carries each pair's contact history (tangential displacement and rolling torque) (the kernels are in :mod:`.neighbors`).
 
 :meth:`NeighborList.rebuild` bins the spheres, gathers every sphere's partners j > i within r_i + r_j + skin,
 writes the new pair list with the history carried over from the current one (two lists swap, so rebuilding
@@ -24,7 +24,7 @@ class PairList:
     """Every listed pair once (owner i < j, runs by owner, sorted by partner), with its history.
 
     start: (N + 1,) run starts by owner; j: partner; xi: tangential displacement [m] as the owner sees it;
-    touching: whether the pair touched at its last evaluation; rev, rev_pair: the pair's place in its partner's
+    roll: the rolling spring's torque on the owner [N m] (contacts under the EPSD law; zero under CDT); touching: whether the pair touched at its last evaluation; rev, rev_pair: the pair's place in its partner's
     run of slots and the inverse; partner_slot: what the pair exerts on its partner (written by the force pass);
     n_particles: spheres the list is for (0: an empty list to carry no history from).
     """
@@ -33,6 +33,7 @@ class PairList:
     start: ti.Ndarray
     j: ti.Ndarray
     xi: ti.Ndarray
+    roll: ti.Ndarray
     touching: ti.Ndarray
     rev: ti.Ndarray
     rev_pair: ti.Ndarray
@@ -43,14 +44,16 @@ class PairList:
     def allocate(cls, n: int, capacity: int) -> "PairList":
         """Arrays for ``n`` spheres with room for ``capacity`` pairs."""
         return cls(capacity, ti.ndarray(ti.i32, shape=n + 1), ti.ndarray(ti.i32, shape=capacity),
-                   ti.Vector.ndarray(3, ti.f64, shape=capacity), ti.ndarray(ti.i32, shape=capacity),
+                   ti.Vector.ndarray(3, ti.f64, shape=capacity), ti.Vector.ndarray(3, ti.f64, shape=capacity),
+                   ti.ndarray(ti.i32, shape=capacity),
                    ti.ndarray(ti.i32, shape=capacity), ti.ndarray(ti.i32, shape=capacity),
                    ti.ndarray(neighbors.mat23, shape=capacity))
 
     @classmethod
-    def from_history(cls, n: int, pair_i: np.ndarray, pair_j: np.ndarray, pair_xi: np.ndarray) -> "PairList":
-        """A list holding the given pairs (sorted by i, then j) and their displacements, to carry them into the
-        first build."""
+    def from_history(cls, n: int, pair_i: np.ndarray, pair_j: np.ndarray, pair_xi: np.ndarray,
+                     pair_roll: np.ndarray) -> "PairList":
+        """A list holding the given pairs (sorted by i, then j), their displacements and rolling torques, to carry
+        them into the first build."""
         out = cls.allocate(n, max(1, len(pair_i)))
         if len(pair_i):
             start = np.zeros(n + 1, np.int32)
@@ -58,7 +61,8 @@ class PairList:
             out.start.from_numpy(start)
             out.j.from_numpy(np.ascontiguousarray(pair_j, dtype=np.int32))
             out.xi.from_numpy(np.ascontiguousarray(pair_xi, dtype=np.float64))
-            out.touching.from_numpy(np.any(pair_xi != 0.0, axis=1).astype(np.int32))
+            out.roll.from_numpy(np.ascontiguousarray(pair_roll, dtype=np.float64))
+            out.touching.from_numpy(np.any((pair_xi != 0.0) | (pair_roll != 0.0), axis=1).astype(np.int32))
             out.n_particles = n
         return out
 
@@ -137,8 +141,8 @@ class NeighborList:
             new = PairList.allocate(self.n, int(n_pairs * 1.25) + 16)
             neighbors.exclusive_scan(self.count, new.start)
         neighbors.fill_pairs(
-            self.nbr, self.count, new.start, new.j, new.xi, new.touching,
-            old.start, old.j, old.xi, old.touching, old.n_particles,
+            self.nbr, self.count, new.start, new.j, new.xi, new.roll, new.touching,
+            old.start, old.j, old.xi, old.roll, old.touching, old.n_particles,
         )
         new.n_particles = self.n
         # Partner slots by partner; zero, as the force pass expects of pairs that are apart (a pair
@@ -152,11 +156,12 @@ class NeighborList:
         integrator.copy_vec3(p.x, p.x_ref)
 
     def history(self) -> dict:
-        """The pair list's history as NumPy arrays: ``pair_i``, ``pair_j``, ``pair_xi``."""
+        """The pair list's history as NumPy arrays: ``pair_i``, ``pair_j``, ``pair_xi``, ``pair_roll``."""
         pairs, n_pairs = self.pairs, self.n_pairs
         owned = np.diff(pairs.start.to_numpy())
         return {
             "pair_i": np.repeat(np.arange(len(owned), dtype=np.int32), owned),
             "pair_j": pairs.j.to_numpy()[:n_pairs],
             "pair_xi": pairs.xi.to_numpy()[:n_pairs],
+            "pair_roll": pairs.roll.to_numpy()[:n_pairs],
         }

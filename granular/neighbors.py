@@ -206,15 +206,17 @@ def fill_pairs(
     pair_start: nd_i32,
     pair_j: nd_i32,
     pair_xi: nd_vec3,
+    pair_roll: nd_vec3,
     pair_touching: nd_i32,
     old_start: nd_i32,
     old_j: nd_i32,
     old_xi: nd_vec3,
+    old_roll: nd_vec3,
     old_touching: nd_i32,
     n_old_particles: ti.i32,
 ):
     """Write the pairs of every particle (its sorted row of partners j > i) into the pair list,
-    carrying each pair's history and touching flag from the previous pair list (a merge of two
+    carrying each pair's history (tangential and rolling) and touching flag from the previous pair list (a merge of two
     sorted lists); new pairs start at zero, untouched."""
     for i in nbr_count:
         p = pair_start[i]
@@ -230,9 +232,11 @@ def fill_pairs(
                 a += 1
             if a < b and old_j[a] == j:
                 pair_xi[p] = old_xi[a]
+                pair_roll[p] = old_roll[a]
                 pair_touching[p] = old_touching[a]
             else:
                 pair_xi[p] = vec3(0.0, 0.0, 0.0)
+                pair_roll[p] = vec3(0.0, 0.0, 0.0)
                 pair_touching[p] = 0
             p += 1
 

@@ -38,6 +38,10 @@ from .stepper import Stepper
 from .timestep import TimeStepEstimate, estimate_time_step
 from .walls import MAX_WALLS, Wall, WallArrays
 
+#: The contact history's per-pair and per-wall arrays: tangential displacement [m], rolling spring torque [N m].
+PAIR_HISTORY = ("pair_xi", "pair_roll")
+WALL_HISTORY = ("xi_wall", "roll_wall")
+
 __all__ = ["DeviceParts", "DeviceState", "Interaction", "MAX_WALLS", "Scene", "Wall"]
 
 
@@ -216,9 +220,8 @@ class Scene:
         self._to_host()
         self.walls.append(Wall(tuple(p), tuple(nrm / length), material, pair))
         if self._hist is not None:
-            self._hist["xi_wall"] = np.concatenate(
-                [self._hist["xi_wall"], np.zeros((self.n_particles, 1, 3))], axis=1
-            )
+            for key in WALL_HISTORY:
+                self._hist[key] = np.concatenate([self._hist[key], np.zeros((self.n_particles, 1, 3))], axis=1)
         return len(self.walls) - 1
 
     def add_box_walls(
@@ -271,11 +274,13 @@ class Scene:
         the wheel contact bin their own objects in the same cells)."""
         return self._to_device().neighbor_list.grid
 
-    def add_spheres(self, positions, radii, velocities=None, angular_velocities=None, *, wall_history=None) -> slice:
+    def add_spheres(self, positions, radii, velocities=None, angular_velocities=None, *, wall_history=None,
+                    wall_roll_history=None) -> slice:
         """Add spheres; arrays are (N, 3) [m], (N,) [m], (N, 3) [m/s], (N, 3) [rad/s].
 
         Returns the slice of particle indices they received. Every sphere must lie inside the domain.
         ``wall_history``: (N, walls, 3) tangential displacements [m] of their wall contacts (default none);
+        ``wall_roll_history``: (N, walls, 3) their rolling spring torques [N m] (EPSD walls; default none);
         pair histories are set with :meth:`set_contact_history`.
         """
         x = _as_array("positions", positions, (3,))
@@ -307,16 +312,19 @@ class Scene:
         self._mobile = np.concatenate([self._mobile, np.ones(n)])
         self._f = np.concatenate([self._f, np.zeros((n, 3))])
         self._t = np.concatenate([self._t, np.zeros((n, 3))])
-        if wall_history is not None:
-            wall_history = np.asarray(wall_history, float)
-            if wall_history.shape != (n, len(self.walls), 3):
-                raise WheelsoilInputError(f"wall_history has shape {wall_history.shape}; expected ({n}, {len(self.walls)}, 3)")
-        if self._hist is None and wall_history is not None:
+        given = {}
+        for key, rows in zip(WALL_HISTORY, (wall_history, wall_roll_history)):
+            if rows is not None:
+                given[key] = np.asarray(rows, float)
+                if given[key].shape != (n, len(self.walls), 3):
+                    raise WheelsoilInputError(f"{key} history has shape {given[key].shape}; expected "
+                                              f"({n}, {len(self.walls)}, 3)")
+        if self._hist is None and given:
             self._hist = self._empty_history(start)
         if self._hist is not None:  # new spheres have no pairs yet; existing indices are unchanged
             h = self._hist
-            rows = np.zeros((n,) + h["xi_wall"].shape[1:]) if wall_history is None else wall_history
-            h["xi_wall"] = np.concatenate([h["xi_wall"], rows])
+            for key in WALL_HISTORY:
+                h[key] = np.concatenate([h[key], given.get(key, np.zeros((n,) + h[key].shape[1:]))])
         if start:
             self._renumbered(np.concatenate([np.arange(start), np.full(n, -1)]))
         return slice(start, start + n)
@@ -344,43 +352,49 @@ class Scene:
         self._x = x
 
     def _empty_history(self, n: int) -> dict:
-        return {"pair_i": np.zeros(0, np.int32), "pair_j": np.zeros(0, np.int32), "pair_xi": np.zeros((0, 3)),
-                "xi_wall": np.zeros((n, len(self.walls), 3))}
+        return {"pair_i": np.zeros(0, np.int32), "pair_j": np.zeros(0, np.int32),
+                **{key: np.zeros((0, 3)) for key in PAIR_HISTORY},
+                **{key: np.zeros((n, len(self.walls), 3)) for key in WALL_HISTORY}}
 
     def contact_history(self) -> dict:
-        """The tangential contact history as NumPy arrays: ``pair_i``, ``pair_j`` (i < j, sorted by i then j),
-        ``pair_xi`` (pairs, 3) [m] (zero for pairs listed but apart) and ``xi_wall`` (N, walls, 3) [m]."""
+        """The contact history as NumPy arrays: ``pair_i``, ``pair_j`` (i < j, sorted by i then j), ``pair_xi``
+        (pairs, 3) tangential displacements [m] and ``pair_roll`` (pairs, 3) rolling spring torques [N m] (zero for
+        pairs listed but apart; the torque is zero under the CDT law), ``xi_wall`` and ``roll_wall`` (N, walls, 3)
+        the same at the walls."""
         self._to_host()
         h = self._hist if self._hist is not None else self._empty_history(self.n_particles)
         return {k: v.copy() for k, v in h.items()}
 
-    def set_contact_history(self, pair_i, pair_j, pair_xi) -> None:
-        """Give the sphere pairs (pair_i[k], pair_j[k]) the tangential displacements pair_xi[k] [m] (replacing
-        what they had): a contact of spheres placed at rest in a state that had it (a prepared bed's).
+    def set_contact_history(self, pair_i, pair_j, pair_xi, pair_roll=None) -> None:
+        """Give the sphere pairs (pair_i[k], pair_j[k]) the tangential displacements pair_xi[k] [m] and rolling
+        spring torques pair_roll[k] [N m] (default zero) (replacing what they had): a contact of spheres placed at
+        rest in a state that had it (a prepared bed's).
 
-        pair_xi[k] is the displacement as sphere pair_i[k] sees it (the force pass's owner convention); a pair
-        given with pair_i > pair_j is turned around (its displacement negated)."""
+        Both are as sphere pair_i[k] sees them (the force pass's owner convention); a pair given with
+        pair_i > pair_j is turned around (both negated)."""
         i = np.asarray(pair_i, np.int64).ravel()
         j = np.asarray(pair_j, np.int64).ravel()
         xi = np.asarray(pair_xi, float).reshape(-1, 3)
+        roll = np.zeros_like(xi) if pair_roll is None else np.asarray(pair_roll, float).reshape(-1, 3)
         n = self.n_particles
-        if not (len(i) == len(j) == len(xi)) or (len(i) and (min(i.min(), j.min()) < 0 or max(i.max(), j.max()) >= n)):
-            raise WheelsoilInputError(f"pair history: pair_i, pair_j (indices below {n}) and pair_xi (pairs, 3) must "
-                                      "have one row per pair")
+        if not (len(i) == len(j) == len(xi) == len(roll)) or (
+                len(i) and (min(i.min(), j.min()) < 0 or max(i.max(), j.max()) >= n)):
+            raise WheelsoilInputError(f"pair history: pair_i, pair_j (indices below {n}), pair_xi and pair_roll "
+                                      "(pairs, 3) must have one row per pair")
         if np.any(i == j):
             raise WheelsoilInputError("pair history: a sphere cannot pair with itself")
         self._to_host()
         h = self._hist if self._hist is not None else self._empty_history(n)
         lo, hi = np.minimum(i, j), np.maximum(i, j)
-        xi = np.where((i > j)[:, None], -xi, xi)
+        turned = (i > j)[:, None]
         all_i = np.concatenate([lo, h["pair_i"]])
         all_j = np.concatenate([hi, h["pair_j"]])
-        all_xi = np.concatenate([xi, h["pair_xi"]])
         keys = all_i * n + all_j
         _, first = np.unique(keys, return_index=True)  # the given rows come first: they win
         order = first[np.lexsort((all_j[first], all_i[first]))]
         h["pair_i"], h["pair_j"] = all_i[order].astype(np.int32), all_j[order].astype(np.int32)
-        h["pair_xi"] = all_xi[order]
+        for key, given in zip(PAIR_HISTORY, (xi, roll)):
+            h[key] = np.concatenate([np.where(turned, -given, given), h[key]])[order]
         self._hist = h
 
     def _renumbered(self, old_of_new: np.ndarray) -> None:
@@ -406,8 +420,10 @@ class Scene:
             pi, pj = new_index[h["pair_i"]], new_index[h["pair_j"]]
             kept = (pi >= 0) & (pj >= 0)  # the renumbering is monotone: pairs stay sorted
             h["pair_i"], h["pair_j"] = pi[kept].astype(np.int32), pj[kept].astype(np.int32)
-            h["pair_xi"] = h["pair_xi"][kept]
-            h["xi_wall"] = h["xi_wall"][mask]
+            for key in PAIR_HISTORY:
+                h[key] = h[key][kept]
+            for key in WALL_HISTORY:
+                h[key] = h[key][mask]
         self._renumbered(np.flatnonzero(mask))
 
     def hold(self, mask) -> None:
@@ -560,6 +576,9 @@ class Scene:
         self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
         self._f, self._t = np.array(state["f"], float), np.array(state["t"], float)
         hist = {k[5:]: np.array(v) for k, v in state.items() if k.startswith("hist_")}
+        for xi_key, roll_key in (PAIR_HISTORY, WALL_HISTORY):
+            if hist and roll_key not in hist:  # a state saved before the rolling history existed
+                hist[roll_key] = np.zeros_like(hist[xi_key])
         self._hist = hist or None
         for k in self._STATE_SCALARS:
             setattr(self, k, type(getattr(self, k))(state[k]))
@@ -615,10 +634,11 @@ class Scene:
         particles = ParticleArrays.upload(self._x, self._v, self._w, self._f, self._t, self._r, self._mobile,
                                           self.material.density)
         # the pair list the first build carries the history from (the host copy, if any)
-        pairs = (PairList.from_history(n, h["pair_i"], h["pair_j"], h["pair_xi"]) if h is not None
+        pairs = (PairList.from_history(n, h["pair_i"], h["pair_j"], h["pair_xi"], h["pair_roll"]) if h is not None
                  else PairList.allocate(n, 1))
         neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs)
-        walls = WallArrays.upload(self.walls, self.material, n, h["xi_wall"] if h is not None else None)
+        walls = WallArrays.upload(self.walls, self.material, n, *((h["xi_wall"], h["roll_wall"]) if h is not None
+                                                                 else (None, None)))
         params = ContactParameters.of(self.material, self.pair)
         self._device = DeviceParts(particles, neighbor_list, walls, params,
                                    Stepper(particles, neighbor_list, walls, params), ti.ndarray(ti.f64, shape=4))
@@ -637,7 +657,7 @@ class Scene:
             return
         state = device.particles.download()
         self._x, self._v, self._w, self._f, self._t = (state[k] for k in ("x", "v", "w", "f", "t"))
-        self._hist = {**device.neighbor_list.history(), "xi_wall": device.walls.history()}
+        self._hist = {**device.neighbor_list.history(), **device.walls.history()}
         self._device = None
 
     # ------------------------------------------------------------------ read-back

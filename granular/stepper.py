@@ -36,9 +36,9 @@ class Stepper:
         if nl.pairs is not self._pairs:
             pairs, w, c = nl.pairs, self.walls, self.params
             self._contact_args = (
-                pairs.start, pairs.j, pairs.xi, pairs.rev, pairs.touching, pairs.partner_slot, nl.rev_start,
-                w.point, w.normal, w.props, w.xi, w.touching, w.near,
-                c.e_eff, c.g_eff, c.beta, c.mu_s, c.mu_r,
+                pairs.start, pairs.j, pairs.xi, pairs.roll, pairs.rev, pairs.touching, pairs.partner_slot,
+                nl.rev_start, w.point, w.normal, w.props, w.xi, w.roll, w.touching, w.near,
+                c.e_eff, c.g_eff, c.beta, c.mu_s, c.mu_r, c.rolling,
             )
             self._pairs = nl.pairs
         return self._contact_args

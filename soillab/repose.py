@@ -85,8 +85,7 @@ def _one_seed(bed: Bed, spec: ReposeSpec, arch) -> ReposeRun:
     for point, normal in (((0, 0, 0), (0, 0, 1)), ((0, 0, 0), (0, 1, 0)), ((0, reach, 0), (0, -1, 0))):
         scene.add_wall(point, normal, material=s.wall_material, pair=s.wall_pair)
     scene.add_spheres(bed.positions, bed.radii)
-    if bed.history is not None and len(bed.history["pair_i"]):
-        scene.set_contact_history(bed.history["pair_i"], bed.history["pair_j"], bed.history["pair_xi"])
+    bed.set_pair_history(scene)
     threshold = s.settle_threshold
     fall = math.sqrt(2 * spec.height / s.gravity_magnitude)
     chunk = max(1, int(round(0.02 / scene.time_step)))

@@ -100,8 +100,7 @@ def _scene(bed: Bed, spec: ShearSpec, arch) -> Scene:
                   gravity=s.gravity, material=s.material, pair=s.pair, arch=arch)
     scene.add_wall((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), material=s.wall_material, pair=s.wall_pair)
     scene.add_spheres(bed.positions, bed.radii)
-    if bed.history is not None and len(bed.history["pair_i"]):
-        scene.set_contact_history(bed.history["pair_i"], bed.history["pair_j"], bed.history["pair_xi"])
+    bed.set_pair_history(scene)
     return scene
 
 

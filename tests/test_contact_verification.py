@@ -9,7 +9,11 @@ References
   Dynamics*; Maw, Barber & Fawcett 1976): P_n = m v_n (1 + e), P_t = mu P_n, so
   v_t' = v_t - mu (1 + e) v_n and omega' = 5/2 mu (1 + e) v_n / R for a solid sphere.
 * Rolling resistance with constant torque M = mu_r m g R on a sphere rolling without slip:
-  (m + I/R^2) dv/dt = -mu_r m g  =>  omega(t) = omega_0 - 5/7 mu_r g t / R.
+  (m + I/R^2) dv/dt = -mu_r m g  =>  omega(t) = omega_0 - 5/7 mu_r g t / R (both rolling laws).
+* EPSD rolling resistance (Ai et al. 2011, model C; k_r = S_t R*^2, Iwashita & Oda 1998): a sphere on a floor
+  under an applied torque M below M_m = mu_r F_n R comes to rest rolled by theta = M / k_r (the floor's friction
+  carries no force at rest, so the spring alone balances M); above M_m it rolls on against M_m:
+  (I + m R^2) d omega/dt = M - M_m.
 """
 
 import math
@@ -25,6 +29,7 @@ from wheelsoil.granular import (
     effective_mass,
     effective_modulus,
     effective_radius,
+    effective_shear_modulus,
 )
 
 SOIL = Material("test soil", youngs_modulus=50e6, poisson_ratio=0.3, density=3200.0)
@@ -140,9 +145,10 @@ def test_oblique_impact_gross_sliding():
     assert abs(w[0]) < 1e-9 and abs(w[2]) < 1e-9
 
 
-def test_rolling_resistance_spin_decay():
+@pytest.mark.parametrize("law", ["cdt", "epsd"])
+def test_rolling_resistance_spin_decay(law):
     mu_r, r, g = 0.1, 0.01, 9.81
-    pair = PairProperties(restitution=0.3, static_friction=0.8, rolling_friction=mu_r)
+    pair = PairProperties(restitution=0.3, static_friction=0.8, rolling_friction=mu_r, rolling_model=law)
     scene = Scene((-5, -1, -1), (5, 1, 1), gravity=(0, 0, -g), material=SOIL, pair=pair)
     scene.add_wall((0, 0, 0), (0, 0, 1), material=None, pair=pair)
     m = SOIL.density * 4 / 3 * math.pi * r**3
@@ -168,6 +174,68 @@ def test_rolling_resistance_spin_decay():
     # and the torque brings the sphere to rest rather than reversing it
     scene.step(int(0.3 * t_stop / dt))
     assert abs(scene.angular_velocities[0, 1]) < 1e-3 * omega0
+
+
+def sphere_under_torque(fraction, dt_factor=1.0, law="epsd", ramp=0.0):
+    """One sphere resting on a rigid floor (mu_r = 0.5, mu_s = 0.5) with a torque about y of ``fraction`` of
+    M_m = mu_r m g R, raised linearly from zero over ``ramp`` seconds (0: applied at once; a sudden torque
+    overshoots the spring's static twist up to twice); returns the scene, the torque [N m] and M_m [N m]."""
+    from wheelsoil.granular.scene import Interaction
+
+    r, g, mu_r = 0.004, 9.81, 0.5
+    pair = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=mu_r, rolling_model=law)
+    scene = Scene((-0.05, -0.05, 0.0), (0.05, 0.05, 0.05), gravity=(0, 0, -g), material=SOIL, pair=pair)
+    scene.add_wall((0, 0, 0), (0, 0, 1), material=None, pair=pair)
+    m = SOIL.density * 4 / 3 * math.pi * r**3
+    overlap = (m * g / (4 / 3 * effective_modulus(SOIL, None) * math.sqrt(r))) ** (2 / 3)
+    scene.add_spheres([[0, 0, r - overlap]], [r])
+    scene.time_step = scene.time_step * dt_factor
+    m_full = mu_r * m * g * r
+    torque = fraction * m_full
+
+    class Torque(Interaction):
+        def add_forces(self, scene, dt):
+            state = scene.device_state()
+            t = state.external_torque.to_numpy()
+            t[0, 1] += torque * (min(1.0, scene.time / ramp) if ramp > 0.0 else 1.0)
+            state.external_torque.from_numpy(t)
+            return 0
+
+    scene.add_interaction(Torque())
+    return scene, torque, m_full
+
+
+@pytest.mark.parametrize("dt_factor", [1.0, 0.5])
+@pytest.mark.parametrize("fraction", [0.3, 0.9])
+def test_epsd_holds_a_torque_below_mobilisation_at_rest(fraction, dt_factor):
+    """The EPSD spring balances the torque and the sphere stops, rolled by theta = M / k_r, at any time step (the
+    CDT law rolls on at M dt / I: docs/soillab/rolling/creep.md)."""
+    scene, torque, _ = sphere_under_torque(fraction, dt_factor, ramp=0.01)
+    r = 0.004
+    scene.step(int(0.03 / scene.time_step))
+    x_rest = scene.positions[0, 0]
+    scene.step(int(0.02 / scene.time_step))
+    m = scene.masses[0]
+    overlap = (m * 9.81 / (4 / 3 * effective_modulus(SOIL, None) * math.sqrt(r))) ** (2 / 3)
+    k_roll = 8 * effective_shear_modulus(SOIL, None) * math.sqrt(r * overlap) * r**2  # S_t R*^2, R* = R
+    theta = torque / k_roll
+    assert abs(scene.angular_velocities[0, 1]) * 0.01 < 1e-3 * theta  # at rest: < 0.1 % of theta more in 10 ms
+    assert scene.positions[0, 0] == pytest.approx(r * theta, rel=2e-2)  # rolled by r theta, tolerance 2 %
+    assert scene.positions[0, 0] == pytest.approx(x_rest, rel=1e-3)  # and stays there
+    spring = scene.contact_history()["roll_wall"][0, 0]
+    assert spring == pytest.approx([0.0, -torque, 0.0], rel=1e-4, abs=1e-9 * torque)  # the spring carries M
+
+
+@pytest.mark.parametrize("law", ["cdt", "epsd"])
+def test_rolling_resistance_gives_way_above_mobilisation(law):
+    """Above M_m the sphere rolls on against M_m under either law: (I + m R^2) d omega/dt = M - M_m."""
+    scene, torque, m_full = sphere_under_torque(1.5, law=law)
+    r, m = 0.004, scene.masses[0]
+    scene.step(int(0.01 / scene.time_step))
+    t0, w0 = scene.time, scene.angular_velocities[0, 1]
+    scene.step(int(0.02 / scene.time_step))
+    rate = (scene.angular_velocities[0, 1] - w0) / (scene.time - t0)
+    assert rate == pytest.approx((torque - m_full) / (1.4 * m * r**2), rel=2e-2)  # tolerance 2 %
 
 
 def elastic_energy(scene):

@@ -13,6 +13,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import ClassVar
 
+from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
 
@@ -76,11 +77,18 @@ class PairProperties:
     static_friction: Coulomb friction coefficient mu_s [-], >= 0.
     rolling_friction: rolling friction coefficient mu_r [-], >= 0 (dimensionless: the torque arm is
         mu_r * R*, as in EDEM and LIGGGHTS ``rolling_friction cdt``).
+    rolling_model: the rolling-resistance law, ``"cdt"`` (constant directional torque, the default) or ``"epsd"``
+        (elastic--plastic spring--dashpot, which holds a torque below mu_r F_n R* at rest); formulas in
+        :mod:`wheelsoil.granular.contact`.
     """
 
     restitution: float
     static_friction: float
     rolling_friction: float
+    rolling_model: str = "cdt"
+
+    #: The rolling-resistance laws (their formulas: :mod:`wheelsoil.granular.contact`).
+    ROLLING_MODELS: ClassVar[tuple[str, ...]] = ("cdt", "epsd")
 
     RANGES: ClassVar[dict[str, Range]] = {
         "restitution": positive(hi=1.0),
@@ -90,6 +98,9 @@ class PairProperties:
 
     def __post_init__(self) -> None:
         check_ranges(self, self.RANGES, "contact pair")
+        if self.rolling_model not in self.ROLLING_MODELS:
+            raise WheelsoilInputError(f"contact pair rolling_model = {self.rolling_model!r} is not one of "
+                                      f"{', '.join(self.ROLLING_MODELS)}")
 
     @property
     def damping_ratio(self) -> float:
@@ -97,7 +108,10 @@ class PairProperties:
         return restitution_damping_ratio(self.restitution)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        if self.rolling_model == "cdt":  # pairs stored before the choice existed keep their form (and hashes)
+            d.pop("rolling_model")
+        return d
 
 
 def restitution_damping_ratio(restitution: float) -> float:
