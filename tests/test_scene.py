@@ -2,6 +2,7 @@
 
 import math
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from wheelsoil.granular import (
     WheelsoilInputError,
     estimate_time_step,
 )
+from wheelsoil.granular.materials import SOIL_SOIL, SOIL_STEEL
 
 
 @pytest.mark.parametrize(
@@ -261,16 +263,17 @@ def test_numpy_round_trip_of_state():
     assert s.masses == pytest.approx(3200 * 4 / 3 * np.pi * np.array([0.01, 0.012]) ** 3)
 
 
-def test_structural_edits_keep_pair_history_and_dynamics():
+@pytest.mark.parametrize("law", ["cdt", "epsd"])
+def test_structural_edits_keep_pair_history_and_dynamics(law):
     """Adding and removing spheres that touch nothing -- which round-trips the state through the host
     and renumbers every pair -- must leave the pile's dynamics unchanged: only possible if every
-    pair's tangential history survives the edit."""
+    pair's tangential (and, under EPSD, rolling) history survives the edit."""
     x, r, v = random_packing()
     far = np.array([[0.14, 0.14, 0.29]])
 
     def pile(with_far):
-        s = Scene((0, 0, 0), (0.15, 0.15, 0.3))
-        s.add_box_walls()
+        s = Scene((0, 0, 0), (0.15, 0.15, 0.3), pair=replace(SOIL_SOIL, rolling_model=law))
+        s.add_box_walls(pair=replace(SOIL_STEEL, rolling_model=law))
         s.add_spheres(np.vstack([far, x]), np.concatenate([[0.006], r]), velocities=np.vstack([[0, 0, 0], v]))
         s.time_step = 5e-5
         return s
@@ -297,3 +300,8 @@ def test_too_many_walls_is_refused_when_added():
     with pytest.raises(WheelsoilInputError, match="at most 31 planar walls"):
         s.add_wall((0, 0, 0), (0, 0, 1))
     assert len(s.walls) == 31
+
+
+def test_an_unknown_rolling_law_is_named():
+    with pytest.raises(WheelsoilInputError, match="rolling_model = 'viscous' is not one of cdt, epsd"):
+        PairProperties(restitution=0.5, static_friction=0.4, rolling_friction=0.1, rolling_model="viscous")
