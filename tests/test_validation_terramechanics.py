@@ -308,3 +308,45 @@ def test_bad_drifts_name_the_key():
         SoilParameters(drift_field="cohesion", drift_condition="load", drift_rate=0.1)
     with pytest.raises(WheelsoilInputError, match="drift_rate = 0.1 needs a drift_field"):
         SoilParameters(drift_rate=0.1)
+
+
+def test_side_bulldozing_is_the_cmu_labs_r_b_integrated():
+    """The CMU lab's side bulldozing (R_b.m, forces.m; Wong 2008) against a direct scipy quadrature of its formula,
+    written out again from the lab's code: h_b the side face's depth below the entry--exit line, X_c = 45 - phi/2,
+    F = sin(beta) |sin(beta)| int r cos(theta) R_b d theta. Zero without steering, and sin^2 beta in between."""
+    from scipy.integrate import quad
+
+    from wheelsoil.validation.side_forces import side_bulldozing_force
+
+    soil = replace(SAND, cohesion=900.0, friction_angle=31.0, density=1400.0)
+    wheel = RigidWheel(radius=0.1, width=0.06)
+    g, r = 9.81, 0.1
+    theta_f, theta_r = 0.6, -0.25
+    phi, gamma, c = np.radians(31.0), 1400.0 * g, 900.0
+    x_c = np.pi / 4 - phi / 2
+
+    def r_b(theta):  # R_b.m, non-Ishigami branch, without the |sin beta| factor
+        h = min(2 * r * np.cos(theta), (np.sin(theta) - np.sin(theta_r)) / (np.sin(theta_f) - np.sin(theta_r))
+                * r * (np.cos(theta_r) - np.cos(theta_f)) - r * (np.cos(theta_r) - np.cos(theta)))
+        return 0.5 * gamma * h**2 / np.tan(x_c) ** 2 * (1 + np.tan(phi) / np.tan(x_c) / 2) + 2 * h * c / np.tan(x_c)
+
+    integral = quad(lambda t: r * np.cos(t) * r_b(t), theta_r, theta_f, epsabs=0, epsrel=1e-12)[0]
+    betas = np.radians([0.0, 30.0, 75.0])
+    got = side_bulldozing_force(soil, wheel, np.full(3, theta_f), np.full(3, theta_r), betas, g)
+    np.testing.assert_allclose(got, np.sin(betas) ** 2 * integral, rtol=1e-9, atol=1e-12)
+    assert got[0] == 0.0 and got[2] > 0.0
+
+
+def test_side_bulldozing_scale_adds_the_side_force_to_the_lateral_force_only():
+    from wheelsoil.validation.side_forces import side_bulldozing_force
+    from wheelsoil.validation.terramechanics import contact_forces
+
+    soil = replace(SAND, c3=0.4, sidewall_scale=0.0)
+    args = (WHEEL, np.array([0.02]), np.array([0.3]), np.array([40.0]), np.array([9.81]))
+    off = contact_forces(soil, *args)
+    on = contact_forces(replace(soil, side_bulldozing_scale=2.0), *args)
+    side = side_bulldozing_force(soil, WHEEL, off["theta_f"], off["theta_r"], np.radians([40.0]), 9.81)
+    assert side[0] > 0.0
+    np.testing.assert_allclose(on["lateral_force"], off["lateral_force"] - 2.0 * side, rtol=1e-12)  # beta > 0: -y
+    for key in ("drawbar_pull", "vertical_force", "torque"):
+        np.testing.assert_array_equal(on[key], off[key])

@@ -31,7 +31,8 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
       F_x = r b  int (tau_x cos theta - sigma sin theta) d theta
       F_z = r b  int (tau_x sin theta + sigma cos theta) d theta
       F_y = -sign(beta) (r b int tau_y d theta + F_s)          T = r^2 b int tau_x d theta
-* sidewall resistance (Schwanghart; seed 003 eqs. 17--19, q = 0) on the side the wheel slides towards;
+* sidewall resistance (Schwanghart; seed 003 eqs. 17--19, q = 0) on the side the wheel slides towards, or the
+  CMU lab's side bulldozing (``R_b.m``, Wong 2008); both in :mod:`.side_forces`;
 * grouser forces (seed 003 eq. 20, passive earth pressure on each grouser in the soil, resolved along the
   grouser's angle), spread over the contact as an average over one grouser pitch;
 * bulldozing resistance of the soil pushed ahead of the wheel (Bekker / Hegedus, :func:`bulldozing_force`);
@@ -48,16 +49,19 @@ its form, not merely "some soil property changes with slip".
 """
 
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY
 
-#: Gauss--Legendre nodes per contact region (front and rear of theta_m); 48 integrate the smooth stress
-#: profiles to better than 1e-8 relative (see tests/test_validation_terramechanics.py).
-QUADRATURE_POINTS = 48
+from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
+from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
+
+__all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
+           "side_bulldozing_force", "bulldozing_force", "grouser_forces", "resultant_shear", "QUADRATURE_POINTS",
+           "gauss_legendre"]
+
 
 #: How the shear stress is split between the heading and the axle (:class:`SoilParameters` ``shear_form``).
 SHEAR_FORMS = ("independent", "resultant")
@@ -105,6 +109,8 @@ class SoilParameters:
         rim speed; it reduces the shear displacement, j_x = r((theta_f - theta)(1 - eta) - (1 - i)(sin
         theta_f - sin theta)) (seed 000 eq. 8). 0: the soil under the wheel is at rest.
     sidewall_scale: factor on Schwanghart's sidewall resistance (seed 003 eq. 19); 0 leaves it out.
+    side_bulldozing_scale: factor on the CMU lab's side bulldozing (``R_b.m``, Wong 2008;
+        :func:`~.side_forces.side_bulldozing_force`); 0 leaves it out.
     grouser_scale: factor on the grouser forces (seed 003 eq. 20); 0 leaves them out.
     radius_scale: surrogate radius R = radius_scale r of a flexible wheel's flattened contact (seed 000,
         effective radius; Table 3); 1: rigid.
@@ -141,6 +147,7 @@ class SoilParameters:
     shear_form: str = "independent"
     soil_flow: float = 0.0
     sidewall_scale: float = 1.0
+    side_bulldozing_scale: float = 0.0
     grouser_scale: float = 1.0
     radius_scale: float = 1.0
     grouser_tip_fraction: float = 0.0
@@ -158,8 +165,8 @@ class SoilParameters:
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
             _positive(key, getattr(self, key))
-        for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "grouser_scale", "grouser_tip_fraction",
-                    "bulldozing_scale", "multipass_k2"):
+        for key in ("cohesion", "kc_prime", "c3", "sidewall_scale", "side_bulldozing_scale", "grouser_scale",
+                    "grouser_tip_fraction", "bulldozing_scale", "multipass_k2"):
             _positive(key, getattr(self, key), allow_zero=True)
         if not (0.0 < self.friction_angle < 60.0):
             raise WheelsoilInputError(
@@ -237,22 +244,6 @@ def _conditions(slip, slip_angle, load, gravity, passes=1.0):
     return arrays[0].shape, slip, np.radians(beta_deg), load, gravity, passes
 
 
-@lru_cache(maxsize=8)
-def gauss_legendre(points: int = QUADRATURE_POINTS) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss--Legendre nodes and weights on [-1, 1], computed once per order (NumPy's eigenvalue solve
-    took half the time of a calibration when it was repeated on every force evaluation)."""
-    x, w = np.polynomial.legendre.leggauss(points)
-    x.flags.writeable = False
-    w.flags.writeable = False
-    return x, w
-
-
-def _gauss(lo: np.ndarray, hi: np.ndarray, nodes: np.ndarray, weights: np.ndarray):
-    """Quadrature points (C, Q) and weights (C, Q) on [lo, hi] per condition."""
-    half = 0.5 * (hi - lo)[:, None]
-    return 0.5 * (hi + lo)[:, None] + half * nodes[None, :], half * weights[None, :]
-
-
 def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
     """The radius the contact integrals use [m]: the shearing radius r + lambda h of a grousered wheel times
     the surrogate-radius scale of a flexible one (both 1 / 0 for the classical rigid wheel)."""
@@ -292,8 +283,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     shear_modulus_y = shear_modulus if soil.drift_field == "shear_modulus_x" else soil.shear_modulus_y
 
     x, w = gauss_legendre()
-    th_front, w_front = _gauss(theta_m, theta_f, x, w)
-    th_rear, w_rear = _gauss(theta_r, theta_m, x, w)
+    th_front, w_front = gauss_on(theta_m, theta_f, x, w)
+    th_rear, w_rear = gauss_on(theta_r, theta_m, x, w)
     span = np.where(theta_m - theta_r > 0.0, theta_m - theta_r, 1.0)[:, None]
     equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
     theta = np.concatenate([th_front, th_rear], axis=1)
@@ -338,6 +329,9 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     f_lateral = r * b * np.sum(weight * tau_y, axis=1)
     if soil.sidewall_scale > 0.0:
         f_lateral = f_lateral + soil.sidewall_scale * sidewall_force(soil, wheel, z, beta, g, density, cohesion)
+    if soil.side_bulldozing_scale > 0.0:
+        f_lateral = f_lateral + soil.side_bulldozing_scale * side_bulldozing_force(
+            soil, wheel, theta_f, theta_r, beta, g, density, cohesion)
     if soil.bulldozing_scale > 0.0:
         fx = fx - soil.bulldozing_scale * bulldozing_force(soil, wheel, z, g, cohesion, density)
     if grousers:
@@ -368,47 +362,6 @@ def resultant_shear(strength, jx, jy, k_x, slip, beta, soil_flow, theta):
     return mobilised * v_t, mobilised * v_l
 
 
-def bearing_capacity_factors(friction_angle_deg: float) -> tuple[float, float, float]:
-    """Modified Terzaghi factors (N_gamma, N_c, N_q) of seed 003 eq. 18 (Coduto 2001)."""
-    phi = np.radians(friction_angle_deg)
-    n_q = np.exp((1.5 * np.pi - phi) * np.tan(phi)) / (2.0 * np.cos(np.pi / 4 + phi / 2) ** 2)
-    n_gamma = 2.0 * (n_q + 1.0) * np.tan(phi) / (1.0 + 0.4 * np.sin(4.0 * phi))
-    n_c = (n_q - 1.0) / np.tan(phi)
-    return float(n_gamma), float(n_c), float(n_q)
-
-
-def _soil_state(soil: SoilParameters, density, cohesion):
-    """Per-condition density [kg/m^3] and cohesion [Pa]: the soil's, unless given (e.g. gravity-scaled or
-    compacted by earlier passes, as :func:`contact_forces` passes them)."""
-    rho = soil.density if density is None else np.asarray(density, float)
-    c = soil.cohesion if cohesion is None else np.asarray(cohesion, float)
-    return rho, c
-
-
-def sidewall_force(soil: SoilParameters, wheel: RigidWheel, sinkage, beta, gravity, density=None,
-                   cohesion=None) -> np.ndarray:
-    """Schwanghart's sidewall resistance (seed 003 eq. 19, surcharge q = 0) [N], magnitude.
-
-    F_s = |sin beta| int_{-r sin theta_f}^{r sin theta_f} (gamma N_gamma f(x) + c N_c) f(x) dx with
-    f(x) = sqrt(r^2 - x^2) - r cos theta_f the depth of the sidewall below the surface; ``density`` and
-    ``cohesion`` override the soil's per condition.
-    """
-    rho, c = _soil_state(soil, density, cohesion)
-    r = wheel.radius
-    z = np.asarray(sinkage, float)
-    n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
-    theta_f = np.arccos(np.clip(1.0 - z / r, -1.0, 1.0))
-    half = r * np.sin(theta_f)
-    x, w = gauss_legendre()
-    xs = half[:, None] * x[None, :]
-    depth = np.clip(np.sqrt(r * r - xs * xs) - r * np.cos(theta_f)[:, None], 0.0, None)
-    gamma = rho * np.asarray(gravity, float) * np.ones_like(z)
-    c = c * np.ones_like(z)
-    integral = np.sum(half[:, None] * w[None, :] * (gamma[:, None] * n_gamma * depth + c[:, None] * n_c) * depth,
-                      axis=1)
-    return np.abs(np.sin(beta)) * integral
-
-
 def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None,
                      density=None) -> np.ndarray:
     """Bulldozing resistance of the soil pushed ahead of a wheel sunk by z [N] (magnitude, against travel).
@@ -427,7 +380,7 @@ def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, 
     n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
     k_pc = (n_c - np.tan(phi)) * np.cos(phi) ** 2
     k_pgamma = (2.0 * n_gamma / np.tan(phi) + 1.0) * np.cos(phi) ** 2
-    rho, c = _soil_state(soil, density, cohesion)
+    rho, c = soil_state(soil, density, cohesion)
     gamma = rho * np.asarray(gravity, float)
     return wheel.width * (0.67 * c * z * k_pc + 0.5 * gamma * z * z * k_pgamma)
 
@@ -442,7 +395,7 @@ def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gr
     ``density`` and ``cohesion`` override the soil's per condition. Returns (F_x, F_z, T) [N, N, N m].
     """
     h, b, r = wheel.grouser_height, wheel.width, wheel.radius
-    rho, c = _soil_state(soil, density, cohesion)
+    rho, c = soil_state(soil, density, cohesion)
     n_phi = np.tan(np.pi / 4 + np.radians(soil.friction_angle) / 2) ** 2
     per_grouser = b * (0.5 * rho * np.asarray(gravity, float) * h * h * n_phi + 2.0 * c * h * np.sqrt(n_phi))
     per_radian = per_grouser * wheel.grouser_count / (2.0 * np.pi)
