@@ -7,6 +7,7 @@ Usage (from the repository root, ``../shared`` beside it; about 15 min a candida
     python docs/soillab_calibration.py run --out docs/soillab/calibration [--resume] [--cache DIR] [--max-candidates N]
     python docs/soillab_calibration.py summary docs/soillab/calibration
     python docs/soillab_calibration.py run --design packing --out docs/soillab/packing --resume --cache DIR
+    python docs/soillab_calibration.py run --design epsd --out docs/soillab/calibration-epsd --resume --cache DIR
 
 What each candidate does, chosen before any result was seen:
 
@@ -34,11 +35,20 @@ loosest. The design keeps the repose match (sliding 0.5, rolling 0.5) and pours 
 friction by 0 (densest) and 0.25 while it settles (``BedSpec.pour_friction_factor``), next to the loose pour (1) as
 reference; each candidate also runs the shear box (5 / 10 / 20 kPa) so the peak angle the hypothesis rests on is
 measured, and is scored by the same objective as the grid.
+
+Design "epsd" (2026-11-27, fixed after the rolling-law check's first point and before any of its own results). The
+CDT rolling resistance creeps under a sub-threshold torque at M dt / I (docs/soillab/rolling/creep.md), and the
+plate's pressure fell in proportion to the pressing speed; the EPSD law holds such a torque at rest. Its first plate
+(sliding 0.5, rolling 0.5, 30 mm/s, docs/soillab/rolling-law) carried 3.3 times the CDT plate's pressure. The
+repose angle and the plates both depend on the law, so the friction grid is run again, the same nine candidates,
+poured and tested with ``rolling_model = "epsd"`` for every soil contact (particles, box, plates), with the shear box,
+scored by the same objective.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import time
@@ -51,18 +61,21 @@ from wheelsoil.soillab.objective import best as objective_best
 
 FRICTIONS = (0.3, 0.5, 0.7)
 ROLLING = (0.1, 0.25, 0.5)
-#: (sliding friction, rolling friction, pour friction factor, with the shear box) of every candidate, per design.
+#: (sliding friction, rolling friction, pour friction factor, with the shear box, rolling law) of every candidate,
+#: per design.
 DESIGNS = {
-    "friction": tuple((mu, mu_r, 1.0, False) for mu in FRICTIONS for mu_r in ROLLING),
-    "packing": ((0.5, 0.5, 0.0, True), (0.5, 0.5, 0.25, True), (0.5, 0.5, 1.0, True)),
+    "friction": tuple((mu, mu_r, 1.0, False, "cdt") for mu in FRICTIONS for mu_r in ROLLING),
+    "packing": ((0.5, 0.5, 0.0, True, "cdt"), (0.5, 0.5, 0.25, True, "cdt"), (0.5, 0.5, 1.0, True, "cdt")),
+    "epsd": tuple((mu, mu_r, 1.0, True, "epsd") for mu in FRICTIONS for mu_r in ROLLING),
 }
 
 
-def candidate_name(mu: float, mu_r: float, pour: float) -> str:
-    return f"mu{mu:g}_mur{mu_r:g}" + ("" if pour == 1.0 else f"_pour{pour:g}")
+def candidate_name(mu: float, mu_r: float, pour: float, law: str = "cdt") -> str:
+    return (f"mu{mu:g}_mur{mu_r:g}" + ("" if pour == 1.0 else f"_pour{pour:g}")
+            + ("" if law == "cdt" else f"_{law}"))
 
 
-def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False) -> dict:
+def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False, law: str = "cdt") -> dict:
     from wheelsoil import soillab
     from wheelsoil.granular.bed import BedSpec, prepare_bed
     from wheelsoil.material import Material, PairProperties
@@ -70,14 +83,16 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
 
     start = time.perf_counter()
     base = soil_lab.PARTICLE_MATERIAL
-    pair = PairProperties(restitution=soil_lab.PARTICLE_PAIR.restitution, static_friction=mu, rolling_friction=mu_r)
+    pair = PairProperties(restitution=soil_lab.PARTICLE_PAIR.restitution, static_friction=mu, rolling_friction=mu_r,
+                          rolling_model=law)
+    tool_pair = dataclasses.replace(soil_lab.TOOL_PAIR, rolling_model=law)
 
     def spec(density):
         material = Material("calibration", youngs_modulus=base.youngs_modulus, poisson_ratio=base.poisson_ratio,
                             density=density)
         return BedSpec(**soil_lab.PLATE_BOX, diameter_min=soil_lab.DIAMETER_MIN, diameter_max=soil_lab.DIAMETER_MAX,
                        material=material, pair=pair, wall_material=soil_lab.TOOL_MATERIAL,
-                       wall_pair=soil_lab.TOOL_PAIR, periodic=False, seed=0, pour_friction_factor=pour)
+                       wall_pair=tool_pair, periodic=False, seed=0, pour_friction_factor=pour)
 
     bed_spec = spec(base.density)
     bed = prepare_bed(bed_spec, cache_dir=cache)
@@ -97,7 +112,7 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
         plates[str(d)] = {"sinkage_m": list(z), "simulated_Pa": list(sim / area), "measured_Pa": list(mea / area),
                           "measured_sd_Pa": list(mea_sd / area), "wall_seconds": result.wall_seconds,
                           "top_offset_m": result.top_offset, "inertial_number": result.inertial_number}
-    row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour,
+    row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour, "rolling_model": law,
            "density": bed_spec.material.density, "packing_fraction":
            bed.packing_fraction, "bulk_density": bed.packing_fraction * bed_spec.material.density,
            "repose_deg": repose.runs[0].angle, "plates": plates}
@@ -119,8 +134,8 @@ def run(args) -> int:
     out = Path(args.out)
     (out / "candidates").mkdir(parents=True, exist_ok=True)
     ran = 0
-    for mu, mu_r, pour, shear in DESIGNS[args.design]:
-        path = out / "candidates" / f"{candidate_name(mu, mu_r, pour)}.json"
+    for mu, mu_r, pour, shear, law in DESIGNS[args.design]:
+        path = out / "candidates" / f"{candidate_name(mu, mu_r, pour, law)}.json"
         if args.resume and path.is_file():
             print(f"{path.name}: done before, kept", flush=True)
             continue
@@ -128,7 +143,7 @@ def run(args) -> int:
             print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
             return summary(args)
         ran += 1
-        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear)
+        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law)
         tmp = path.with_suffix(".partial")
         tmp.write_text(json.dumps(row, indent=1))
         tmp.replace(path)
