@@ -130,6 +130,17 @@ def test_case_hash_ignores_the_name_and_follows_the_physics():
     assert load_case("mini-1g-steer", ["case.seed=1"]).case_hash() != a.case_hash()
 
 
+def test_the_rolling_law_reaches_every_soil_contact_and_the_default_keeps_the_hash():
+    a = load_case("mini-1g-steer")
+    assert load_case("mini-1g-steer", ["soil.rolling_model='cdt'"]).case_hash() == a.case_hash()
+    epsd = load_case("mini-1g-steer", ["soil.rolling_model='epsd'"])
+    assert epsd.case_hash() != a.case_hash()
+    bed, test = build.bed_spec(epsd), build.testbed_spec(epsd)
+    assert bed.pair.rolling_model == bed.wall_pair.rolling_model == test.pair.rolling_model == "epsd"
+    assert build.bed_spec(a).cache_key() != bed.cache_key()
+    assert build.bed_spec(a).pair.rolling_model == "cdt"
+
+
 def test_presets_hold_the_seed004_settings():
     full = load_case("seed004-1g-steer")
     bed = build.bed_spec(full)
