@@ -119,13 +119,7 @@ class MovingPatch:
         x[:, 0] = np.mod(x[:, 0], self.length)
         self.template_x, self.template_r = x, bed.radii.copy()
         self.template = bed
-        h = bed.history
-        if h is not None and len(h["pair_i"]):
-            xi = np.asarray(h["pair_xi"], float)
-            self._pairs = (np.asarray(h["pair_i"], np.int64), np.asarray(h["pair_j"], np.int64), xi,
-                           np.asarray(h.get("pair_roll", np.zeros_like(xi)), float))
-        else:
-            self._pairs = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)))
+        self._history = bed.history
         self.creep_tolerance = 0.01  # fraction of a radius a sphere may have crept and still count as unmoved
         self.ids = np.zeros(0, np.int64)  # each sphere's template sphere
         self.expected = np.zeros((0, 3))  # where the template puts it today [m]
@@ -177,9 +171,7 @@ class MovingPatch:
         self._keep(scene, ~out)
         new, new_x = new[keep_new], new_x[keep_new]
         first = scene.n_particles
-        wall = [self.template._wall_history(scene, key) for key in ("xi_wall", "roll_wall")]
-        scene.add_spheres(new_x, self.template_r[new], wall_history=None if wall[0] is None else wall[0][new],
-                          wall_roll_history=None if wall[1] is None else wall[1][new])
+        scene.add_spheres(new_x, self.template_r[new], **self.template.wall_history_for(scene, new))
         self.ids = np.concatenate([self.ids, new])
         self.expected = np.concatenate([self.expected, new_x])
         self._restore_pairs(scene, np.arange(first, scene.n_particles))
@@ -199,9 +191,10 @@ class MovingPatch:
         other, and with spheres already in the bin that sit where the template puts them (within
         ``creep_tolerance`` of a radius), so the new zone joins the soil behind it in the template's
         equilibrium instead of re-seating."""
-        pi, pj, pxi, proll = self._pairs
-        if not len(pi) or not len(placed):
+        h = self._history
+        if h is None or not h.n_pairs or not len(placed):
             return
+        pi, pj = h.pair_i.astype(np.int64), h.pair_j.astype(np.int64)
         x, r = scene.positions, scene.radii
         unmoved = np.linalg.norm(x - self.expected, axis=1) <= self.creep_tolerance * r
         unmoved[placed] = True
@@ -211,7 +204,7 @@ class MovingPatch:
         is_new[self.ids[placed]] = True
         sel = (is_new[pi] | is_new[pj]) & (where[pi] >= 0) & (where[pj] >= 0)
         if sel.any():
-            scene.set_contact_history(where[pi[sel]], where[pj[sel]], pxi[sel], proll[sel])
+            scene.set_contact_history(where[pi[sel]], where[pj[sel]], h.pair_xi[sel], h.pair_roll[sel])
 
     def _clear_of(self, x: np.ndarray, r: np.ndarray, new_x: np.ndarray, new_r: np.ndarray) -> np.ndarray:
         """Which new spheres overlap no kept sphere by more than ``overlap_tolerance`` of the smaller radius."""

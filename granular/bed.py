@@ -38,6 +38,7 @@ from wheelsoil.provenance import atomic_output, provenance
 from wheelsoil.ranges import Range, check_ranges, positive
 
 from . import runtime
+from .contact_history import ContactHistory
 from .errors import SimulationUnstableError, WheelsoilInputError
 from .materials import SOIL_STEEL, STEEL, Material, PairProperties
 from .ordering import column_order
@@ -204,9 +205,11 @@ class Bed:
     packing_fraction: float
     settle_time: float
     meta: dict = field(default_factory=dict)
-    #: Tangential contact history of the settled bed (``Scene.contact_history`` arrays plus ``wall_point`` and
-    #: ``wall_normal`` of the walls its ``xi_wall`` columns belong to); None for beds of format 2.
-    history: dict | None = None
+    #: The settled bed's contact history (:meth:`Scene.contact_history`, renumbered to the bed's order); None for
+    #: beds of format 2.
+    history: ContactHistory | None = None
+    #: (W, 2, 3) the point and normal [m, -] of each wall the history's wall columns belong to.
+    wall_planes: np.ndarray | None = None
 
     @property
     def n_particles(self) -> int:
@@ -234,8 +237,10 @@ class Bed:
             grp.create_dataset("radius", data=self.radii).attrs["units"] = "m"
             if self.history is not None:
                 hist = f.create_group("contacts")
-                for key, value in self.history.items():
+                for key, value in self.history.to_arrays().items():
                     hist.create_dataset(key, data=value)
+                hist.create_dataset("wall_point", data=self.wall_planes[:, 0])
+                hist.create_dataset("wall_normal", data=self.wall_planes[:, 1])
             f.attrs["kind"] = "wheelsoil soil bed"
             f.attrs["bed_format"] = BED_FORMAT_VERSION
             f.attrs["spec"] = json.dumps(self.spec.to_dict(), sort_keys=True)
@@ -259,7 +264,7 @@ class Bed:
                 raise WheelsoilInputError(f"{str(path)!r} is not a wheelsoil soil-bed file")
             p = f["particles"]
             meta = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
-            history = {k: f["contacts"][k][()] for k in f["contacts"]} if "contacts" in f else None
+            arrays = {k: f["contacts"][k][()] for k in f["contacts"]} if "contacts" in f else None
             return cls(
                 spec=BedSpec.from_dict(json.loads(f.attrs["spec"])),
                 positions=p["position"][...],
@@ -270,7 +275,8 @@ class Bed:
                 packing_fraction=float(f.attrs["packing_fraction"]),
                 settle_time=float(f.attrs["settle_time"]),
                 meta={k: meta[k] for k in ("version", "git_rev", "taichi_version", "arch", "created") if k in meta},
-                history=history,
+                history=None if arrays is None else ContactHistory.from_arrays(arrays),
+                wall_planes=None if arrays is None else np.stack([arrays["wall_point"], arrays["wall_normal"]], axis=1),
             )
 
     def to_scene(self, *, headroom: float | None = None, arch: str | None = None, periodic_x: bool | None = None,
@@ -303,8 +309,7 @@ class Bed:
             x = x.copy()
             x[:, 0] = np.mod(x[:, 0], s.length)
         scene.add_spheres(x, self.radii, self.velocities, self.angular_velocities,
-                          wall_history=self._wall_history(scene, "xi_wall"),
-                          wall_roll_history=self._wall_history(scene, "roll_wall"))
+                          **self.wall_history_for(scene, np.arange(self.n_particles)))
         self.set_pair_history(scene)
         if s.time_step is not None:
             scene.time_step = s.time_step
@@ -314,20 +319,23 @@ class Bed:
     def set_pair_history(self, scene: Scene) -> None:
         """Give ``scene``'s spheres (this bed's, in its order) the bed's pair contact history."""
         h = self.history
-        if h is not None and len(h["pair_i"]):
-            scene.set_contact_history(h["pair_i"], h["pair_j"], h["pair_xi"], h.get("pair_roll"))
+        if h is not None and h.n_pairs:
+            scene.set_contact_history(h.pair_i, h.pair_j, h.pair_xi, h.pair_roll)
 
-    def _wall_history(self, scene: Scene, key: str) -> np.ndarray | None:
-        """The bed's wall history ``key`` (``xi_wall`` or ``roll_wall``) in the columns of ``scene``'s walls (matched
-        by point and normal; zero for a wall the bed had not)."""
+    def wall_history_for(self, scene: Scene, spheres: np.ndarray) -> dict:
+        """The wall contacts of the bed's ``spheres`` in the columns of ``scene``'s walls (matched by point and
+        normal; zero for a wall the bed had not), as :meth:`Scene.add_spheres` takes them (empty without a
+        history)."""
         h = self.history
-        if h is None or key not in h:
-            return None
-        out = np.zeros((self.n_particles, len(scene.walls), 3))
+        if h is None:
+            return {}
+        out = {"wall_history": np.zeros((len(spheres), len(scene.walls), 3))}
+        out["wall_roll_history"] = out["wall_history"].copy()
         for k, wall in enumerate(scene.walls):
-            for b, (point, normal) in enumerate(zip(h["wall_point"], h["wall_normal"])):
+            for b, (point, normal) in enumerate(self.wall_planes):
                 if np.allclose(normal, wall.normal) and abs(np.dot(np.asarray(wall.point) - point, normal)) < 1e-12:
-                    out[:, k] = h[key][:, b]
+                    out["wall_history"][:, k] = h.xi_wall[spheres, b]
+                    out["wall_roll_history"][:, k] = h.roll_wall[spheres, b]
         return out
 
 
@@ -547,8 +555,6 @@ def prepare_bed(
     if spec.periodic:
         x[:, 0] = np.mod(x[:, 0], spec.length)
     surface = measure_surface(x, r, spec)
-    history = {**history_in_order(scene.contact_history(), order),
-               "wall_point": np.array([w.point for w in scene.walls]), "wall_normal": np.array([w.normal for w in scene.walls])}
     bed = Bed(
         spec=spec,
         positions=x,
@@ -559,30 +565,13 @@ def prepare_bed(
         packing_fraction=measure_packing_fraction(x, r, spec, surface),
         settle_time=t_settle + t_level,
         meta={"prepare_seconds": time.perf_counter() - wall_clock, "time_step": scene.time_step},
-        history=history,
+        history=scene.contact_history().in_order(order),
+        wall_planes=np.array([[w.point, w.normal] for w in scene.walls], float).reshape(-1, 2, 3),
     )
     if use_cache:
         bed.save(path)
     bed.meta.update(cache_path=str(path) if use_cache else "", from_cache=False)
     return bed
-
-
-def history_in_order(hist: dict, order: np.ndarray) -> dict:
-    """The touching pairs and the wall contacts of a contact history (``Scene.contact_history``) with the spheres
-    renumbered so that new sphere k is old sphere ``order[k]``.
-
-    A pair is owned by its lower index and its displacement and rolling torque are as the owner sees them, so a pair
-    whose two spheres swap order is turned around: both are negated."""
-    new_index = np.empty(len(order), np.int64)
-    new_index[order] = np.arange(len(order))
-    pi, pj = new_index[hist["pair_i"]], new_index[hist["pair_j"]]
-    touching = np.any((hist["pair_xi"] != 0.0) | (hist["pair_roll"] != 0.0), axis=1)
-    sign = np.where(pi > pj, -1.0, 1.0)[:, None]
-    pi, pj = np.minimum(pi, pj)[touching], np.maximum(pi, pj)[touching]
-    srt = np.lexsort((pj, pi))
-    return {"pair_i": pi[srt].astype(np.int32), "pair_j": pj[srt].astype(np.int32),
-            **{key: (sign * hist[key])[touching][srt] for key in ("pair_xi", "pair_roll")},
-            **{key: hist[key][order] for key in ("xi_wall", "roll_wall")}}
 
 
 def load_bed(path: str | Path) -> Bed:

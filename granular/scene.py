@@ -29,6 +29,7 @@ import taichi as ti
 
 from . import integrator, runtime
 from .contact import ContactParameters
+from .contact_history import ContactHistory
 from .errors import SimulationUnstableError, WheelsoilInputError
 from .grid import UniformGrid
 from .materials import LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL, Material, PairProperties, effective_modulus
@@ -37,10 +38,6 @@ from .particles import DeviceState, ParticleArrays
 from .stepper import Stepper
 from .timestep import TimeStepEstimate, estimate_time_step
 from .walls import MAX_WALLS, Wall, WallArrays
-
-#: The contact history's per-pair and per-wall arrays: tangential displacement [m], rolling spring torque [N m].
-PAIR_HISTORY = ("pair_xi", "pair_roll")
-WALL_HISTORY = ("xi_wall", "roll_wall")
 
 __all__ = ["DeviceParts", "DeviceState", "Interaction", "MAX_WALLS", "Scene", "Wall"]
 
@@ -188,7 +185,7 @@ class Scene:
         self._mobile = np.zeros(0)  # 1: integrated; 0: held in place (see hold)
         self._f = np.zeros((0, 3))
         self._t = np.zeros((0, 3))
-        self._hist: dict | None = None  # pair list with tangential history, wall history (host copy)
+        self._hist: ContactHistory | None = None  # the contacts' memory (host copy; None: no contact yet)
         self._device: DeviceParts | None = None
 
     # ------------------------------------------------------------------ building the scene
@@ -220,8 +217,7 @@ class Scene:
         self._to_host()
         self.walls.append(Wall(tuple(p), tuple(nrm / length), material, pair))
         if self._hist is not None:
-            for key in WALL_HISTORY:
-                self._hist[key] = np.concatenate([self._hist[key], np.zeros((self.n_particles, 1, 3))], axis=1)
+            self._hist = self._hist.with_wall()
         return len(self.walls) - 1
 
     def add_box_walls(
@@ -312,19 +308,14 @@ class Scene:
         self._mobile = np.concatenate([self._mobile, np.ones(n)])
         self._f = np.concatenate([self._f, np.zeros((n, 3))])
         self._t = np.concatenate([self._t, np.zeros((n, 3))])
-        given = {}
-        for key, rows in zip(WALL_HISTORY, (wall_history, wall_roll_history)):
-            if rows is not None:
-                given[key] = np.asarray(rows, float)
-                if given[key].shape != (n, len(self.walls), 3):
-                    raise WheelsoilInputError(f"{key} history has shape {given[key].shape}; expected "
-                                              f"({n}, {len(self.walls)}, 3)")
-        if self._hist is None and given:
-            self._hist = self._empty_history(start)
+        given = [None if rows is None else np.asarray(rows, float) for rows in (wall_history, wall_roll_history)]
+        for name, rows in zip(("wall_history", "wall_roll_history"), given):
+            if rows is not None and rows.shape != (n, len(self.walls), 3):
+                raise WheelsoilInputError(f"{name} has shape {rows.shape}; expected ({n}, {len(self.walls)}, 3)")
+        if self._hist is None and any(rows is not None for rows in given):
+            self._hist = ContactHistory.empty(start, len(self.walls))
         if self._hist is not None:  # new spheres have no pairs yet; existing indices are unchanged
-            h = self._hist
-            for key in WALL_HISTORY:
-                h[key] = np.concatenate([h[key], given.get(key, np.zeros((n,) + h[key].shape[1:]))])
+            self._hist = self._hist.with_spheres(n, *given)
         if start:
             self._renumbered(np.concatenate([np.arange(start), np.full(n, -1)]))
         return slice(start, start + n)
@@ -351,19 +342,13 @@ class Scene:
             raise WheelsoilInputError(f"translating by {off.tolist()} m moves {outside.size} spheres out of the domain")
         self._x = x
 
-    def _empty_history(self, n: int) -> dict:
-        return {"pair_i": np.zeros(0, np.int32), "pair_j": np.zeros(0, np.int32),
-                **{key: np.zeros((0, 3)) for key in PAIR_HISTORY},
-                **{key: np.zeros((n, len(self.walls), 3)) for key in WALL_HISTORY}}
-
-    def contact_history(self) -> dict:
-        """The contact history as NumPy arrays: ``pair_i``, ``pair_j`` (i < j, sorted by i then j), ``pair_xi``
-        (pairs, 3) tangential displacements [m] and ``pair_roll`` (pairs, 3) rolling spring torques [N m] (zero for
-        pairs listed but apart; the torque is zero under the CDT law), ``xi_wall`` and ``roll_wall`` (N, walls, 3)
-        the same at the walls."""
+    def contact_history(self) -> ContactHistory:
+        """The contacts' memory (:class:`.contact_history.ContactHistory`): each pair's and each wall contact's
+        tangential displacement [m] and rolling spring torque [N m]."""
         self._to_host()
-        h = self._hist if self._hist is not None else self._empty_history(self.n_particles)
-        return {k: v.copy() for k, v in h.items()}
+        if self._hist is None:
+            return ContactHistory.empty(self.n_particles, len(self.walls))
+        return ContactHistory(**self._hist.to_arrays())  # a copy: the caller may edit it
 
     def set_contact_history(self, pair_i, pair_j, pair_xi, pair_roll=None) -> None:
         """Give the sphere pairs (pair_i[k], pair_j[k]) the tangential displacements pair_xi[k] [m] and rolling
@@ -372,30 +357,9 @@ class Scene:
 
         Both are as sphere pair_i[k] sees them (the force pass's owner convention); a pair given with
         pair_i > pair_j is turned around (both negated)."""
-        i = np.asarray(pair_i, np.int64).ravel()
-        j = np.asarray(pair_j, np.int64).ravel()
-        xi = np.asarray(pair_xi, float).reshape(-1, 3)
-        roll = np.zeros_like(xi) if pair_roll is None else np.asarray(pair_roll, float).reshape(-1, 3)
-        n = self.n_particles
-        if not (len(i) == len(j) == len(xi) == len(roll)) or (
-                len(i) and (min(i.min(), j.min()) < 0 or max(i.max(), j.max()) >= n)):
-            raise WheelsoilInputError(f"pair history: pair_i, pair_j (indices below {n}), pair_xi and pair_roll "
-                                      "(pairs, 3) must have one row per pair")
-        if np.any(i == j):
-            raise WheelsoilInputError("pair history: a sphere cannot pair with itself")
         self._to_host()
-        h = self._hist if self._hist is not None else self._empty_history(n)
-        lo, hi = np.minimum(i, j), np.maximum(i, j)
-        turned = (i > j)[:, None]
-        all_i = np.concatenate([lo, h["pair_i"]])
-        all_j = np.concatenate([hi, h["pair_j"]])
-        keys = all_i * n + all_j
-        _, first = np.unique(keys, return_index=True)  # the given rows come first: they win
-        order = first[np.lexsort((all_j[first], all_i[first]))]
-        h["pair_i"], h["pair_j"] = all_i[order].astype(np.int32), all_j[order].astype(np.int32)
-        for key, given in zip(PAIR_HISTORY, (xi, roll)):
-            h[key] = np.concatenate([np.where(turned, -given, given), h[key]])[order]
-        self._hist = h
+        base = self._hist if self._hist is not None else ContactHistory.empty(self.n_particles, len(self.walls))
+        self._hist = base.with_pairs(pair_i, pair_j, pair_xi, pair_roll)
 
     def _renumbered(self, old_of_new: np.ndarray) -> None:
         """Tell the interactions that sphere k is now the former sphere old_of_new[k] (-1: a new one)."""
@@ -414,16 +378,7 @@ class Scene:
         for name in ("_x", "_v", "_w", "_r", "_mobile", "_f", "_t"):
             setattr(self, name, getattr(self, name)[mask])
         if self._hist is not None:
-            h = self._hist
-            new_index = np.full(mask.size, -1, np.int64)
-            new_index[mask] = np.arange(int(mask.sum()))
-            pi, pj = new_index[h["pair_i"]], new_index[h["pair_j"]]
-            kept = (pi >= 0) & (pj >= 0)  # the renumbering is monotone: pairs stay sorted
-            h["pair_i"], h["pair_j"] = pi[kept].astype(np.int32), pj[kept].astype(np.int32)
-            for key in PAIR_HISTORY:
-                h[key] = h[key][kept]
-            for key in WALL_HISTORY:
-                h[key] = h[key][mask]
+            self._hist = self._hist.kept(mask)
         self._renumbered(np.flatnonzero(mask))
 
     def hold(self, mask) -> None:
@@ -556,7 +511,7 @@ class Scene:
         self._to_host()
         out = {"x": self._x, "v": self._v, "w": self._w, "f": self._f, "t": self._t, "r": self._r,
                "mobile": self._mobile}
-        for key, value in (self._hist or {}).items():
+        for key, value in (self._hist.to_arrays() if self._hist is not None else {}).items():
             out[f"hist_{key}"] = value
         out.update({k: getattr(self, k) for k in self._STATE_SCALARS})
         return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in out.items()}
@@ -575,11 +530,8 @@ class Scene:
         self._mobile = np.array(state["mobile"], float) if "mobile" in state else np.ones(len(r))
         self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
         self._f, self._t = np.array(state["f"], float), np.array(state["t"], float)
-        hist = {k[5:]: np.array(v) for k, v in state.items() if k.startswith("hist_")}
-        for xi_key, roll_key in (PAIR_HISTORY, WALL_HISTORY):
-            if hist and roll_key not in hist:  # a state saved before the rolling history existed
-                hist[roll_key] = np.zeros_like(hist[xi_key])
-        self._hist = hist or None
+        hist = {k[5:]: v for k, v in state.items() if k.startswith("hist_")}
+        self._hist = ContactHistory.from_arrays(hist) if hist else None
         for k in self._STATE_SCALARS:
             setattr(self, k, type(getattr(self, k))(state[k]))
 
@@ -634,10 +586,10 @@ class Scene:
         particles = ParticleArrays.upload(self._x, self._v, self._w, self._f, self._t, self._r, self._mobile,
                                           self.material.density)
         # the pair list the first build carries the history from (the host copy, if any)
-        pairs = (PairList.from_history(n, h["pair_i"], h["pair_j"], h["pair_xi"], h["pair_roll"]) if h is not None
+        pairs = (PairList.from_history(n, h.pair_i, h.pair_j, h.pair_xi, h.pair_roll) if h is not None
                  else PairList.allocate(n, 1))
         neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs)
-        walls = WallArrays.upload(self.walls, self.material, n, *((h["xi_wall"], h["roll_wall"]) if h is not None
+        walls = WallArrays.upload(self.walls, self.material, n, *((h.xi_wall, h.roll_wall) if h is not None
                                                                  else (None, None)))
         params = ContactParameters.of(self.material, self.pair)
         self._device = DeviceParts(particles, neighbor_list, walls, params,
@@ -657,7 +609,7 @@ class Scene:
             return
         state = device.particles.download()
         self._x, self._v, self._w, self._f, self._t = (state[k] for k in ("x", "v", "w", "f", "t"))
-        self._hist = {**device.neighbor_list.history(), **device.walls.history()}
+        self._hist = ContactHistory(**device.neighbor_list.history(), **device.walls.history())
         self._device = None
 
     # ------------------------------------------------------------------ read-back

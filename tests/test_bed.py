@@ -180,18 +180,27 @@ def test_a_bed_past_the_machine_memory_is_refused_before_any_work_naming_the_key
 def test_history_in_column_order_turns_around_the_pairs_whose_owner_changes():
     """A pair's history is as its owner (the lower index) sees it: renumbering that swaps the two spheres of a pair
     must negate its displacement and rolling torque; pairs apart are dropped; wall rows follow their spheres."""
-    from wheelsoil.granular.bed import history_in_order
+    from wheelsoil.granular.contact_history import ContactHistory
 
     a, b = np.array([1.0, 2.0, 3.0]), np.array([-4.0, 5.0, 0.5])
-    hist = {"pair_i": np.array([0, 0, 1]), "pair_j": np.array([1, 2, 2]),
-            "pair_xi": np.array([a, np.zeros(3), b]), "pair_roll": np.array([2 * a, np.zeros(3), np.zeros(3)]),
-            "xi_wall": np.arange(9.0).reshape(3, 1, 3), "roll_wall": np.zeros((3, 1, 3))}
-    out = history_in_order(hist, np.array([2, 0, 1]))  # new 0 = old 2, new 1 = old 0, new 2 = old 1
+    hist = ContactHistory(np.array([0, 0, 1]), np.array([1, 2, 2]), np.array([a, np.zeros(3), b]),
+                          np.array([2 * a, np.zeros(3), np.zeros(3)]), np.arange(9.0).reshape(3, 1, 3),
+                          np.zeros((3, 1, 3)))
+    out = hist.in_order(np.array([2, 0, 1]))  # new 0 = old 2, new 1 = old 0, new 2 = old 1
     # old (0, 1) -> new (1, 2): same order; old (1, 2) -> new (2, 0): turned around; old (0, 2) is apart
-    assert out["pair_i"].tolist() == [0, 1] and out["pair_j"].tolist() == [2, 2]
-    np.testing.assert_array_equal(out["pair_xi"], [-b, a])
-    np.testing.assert_array_equal(out["pair_roll"], [np.zeros(3), 2 * a])
-    np.testing.assert_array_equal(out["xi_wall"][:, 0], hist["xi_wall"][[2, 0, 1], 0])
+    assert out.pair_i.tolist() == [0, 1] and out.pair_j.tolist() == [2, 2]
+    np.testing.assert_array_equal(out.pair_xi, [-b, a])
+    np.testing.assert_array_equal(out.pair_roll, [np.zeros(3), 2 * a])
+    np.testing.assert_array_equal(out.xi_wall[:, 0], hist.xi_wall[[2, 0, 1], 0])
+
+
+def test_a_bed_file_keeps_its_contact_history(cache, tmp_path):
+    bed = prepare_bed(BedSpec(**TINY), cache_dir=cache)
+    assert bed.history is not None and bed.history.n_pairs > 0
+    loaded = load_bed(bed.save(tmp_path / "bed.h5"))
+    for key, value in bed.history.to_arrays().items():
+        np.testing.assert_array_equal(getattr(loaded.history, key), value)
+    np.testing.assert_array_equal(loaded.wall_planes, bed.wall_planes)
 
 
 @pytest.mark.parametrize("periodic", [False, True])

@@ -222,7 +222,7 @@ def test_epsd_holds_a_torque_below_mobilisation_at_rest(fraction, dt_factor):
     assert abs(scene.angular_velocities[0, 1]) * 0.01 < 1e-3 * theta  # at rest: < 0.1 % of theta more in 10 ms
     assert scene.positions[0, 0] == pytest.approx(r * theta, rel=2e-2)  # rolled by r theta, tolerance 2 %
     assert scene.positions[0, 0] == pytest.approx(x_rest, rel=1e-3)  # and stays there
-    spring = scene.contact_history()["roll_wall"][0, 0]
+    spring = scene.contact_history().roll_wall[0, 0]
     assert spring == pytest.approx([0.0, -torque, 0.0], rel=1e-4, abs=1e-9 * torque)  # the spring carries M
 
 
