@@ -35,9 +35,11 @@ half thickness h (the contact surface lies h either side of the facet's mid-surf
   balance exactly between particles and wheel (action = reaction to round-off). No nodal moments
   are applied: a shell node's small rotary inertia would make them stiff;
 * the wheel advances over a DEM step with the forces of the last evaluation, each node's force
-  linearised about the position it was evaluated at with the contacts' lumped normal stiffness
-  (f - k (x - x_eval)); holding the force constant instead lets light nodes (a coarse grouser's tip)
-  that several loaded spheres press on run unstable at the DEM step.
+  linearised with the contacts' lumped normal stiffness, f - k (x - x_a), about x_a, the node's position carried
+  ahead at its velocity to the mean of the sub-steps' positions (:func:`.kernels.node_load`): holding the force
+  constant instead lets light nodes (a coarse grouser's tip) that several loaded spheres press on run unstable at
+  the DEM step, and linearising about the evaluated position itself gives a node moving into the soil more than f
+  on average, so the wheel did not carry the force the soil reported (issue 35).
 """
 
 from __future__ import annotations
@@ -118,6 +120,7 @@ class WheelContact(Interaction):
         self.health_every = max(1, int(health_every))
         self.rebuilds = 0
         self.structure_substeps = 0
+        self._last_substeps = 1  # sub-steps of the structure's last advance (the next one's, as it stays put)
         self._steps = 0
         self._n_contacts = 0
         sf = self.surface
@@ -222,7 +225,8 @@ class WheelContact(Interaction):
         """Advance the wheel over [t, t + dt] with the loads of the last contact evaluation."""
         if self.advance_structure:
             self._steps += 1
-            self.structure_substeps += self.structure.advance(dt, check=self._steps % self.health_every == 0)
+            self._last_substeps = self.structure.advance(dt, check=self._steps % self.health_every == 0)
+            self.structure_substeps += self._last_substeps
 
     def add_forces(self, scene: Scene, dt: float) -> int:
         """Evaluate every sphere--wheel contact at the current positions (see the module docstring)."""
@@ -258,7 +262,8 @@ class WheelContact(Interaction):
         k.wheel_contacts_graph(
             *particles, self._n_active, *rest,
             self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
-            ROLLING_MODELS[self.pair.rolling_model], dt, self._stats,
+            ROLLING_MODELS[self.pair.rolling_model], dt, dt * (self._last_substeps - 1) / (2 * self._last_substeps),
+            self._stats,
         )
 
     # ------------------------------------------------------------------ measured quantities
@@ -285,7 +290,7 @@ class WheelContact(Interaction):
         return out
 
     # ------------------------------------------------------------------ checkpoints
-    _STATE_SCALARS = ("rebuilds", "structure_substeps", "_steps", "_n_contacts")
+    _STATE_SCALARS = ("rebuilds", "structure_substeps", "_steps", "_n_contacts", "_last_substeps")
 
     def state(self) -> dict:
         """Per-particle contact history, the force accumulators and counters (for checkpoints)."""
@@ -316,7 +321,7 @@ class WheelContact(Interaction):
     def restore_state(self, scene: Scene, state: dict) -> None:
         """Continue from a :meth:`state` taken with the same wheel on ``scene``'s particles."""
         for key in self._STATE_SCALARS:
-            setattr(self, key, int(state[key]))
+            setattr(self, key, int(state.get(key, 1)) if key == "_last_substeps" else int(state[key]))
         self._resultant.from_numpy(np.asarray(state["resultant"], float))
         if "hist_count" in state:
             self._attach(scene)

@@ -275,10 +275,18 @@ def facet_moment_forces(s: ti.i32, xw: ti.template(), tri: ti.template(), moment
 def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corners: ti.template(),
               facet_start: ti.template(), facet_entries: ti.template(), keep: ti.template(), bary: ti.template(),
               f_wheel: ti.template(), m_wheel: ti.template(), stiffness: ti.template(), xw: ti.template(),
-              tri: ti.template(), f_ext: ti.template(), k_ext: ti.template(), x_anchor: ti.template()):
+              vw: ti.template(), tri: ti.template(), f_ext: ti.template(), k_ext: ti.template(),
+              x_anchor: ti.template(), anchor_lead: ti.f64):
     """Phase D, surface node ``u``: gather the reactions of the kept contacts on its facets (barycentric share
     of the force, plus the moment's nodal force lam x arm) and their lumped normal stiffness; a gather, so
-    no two threads write one node."""
+    no two threads write one node.
+
+    The structure feels f - k (x - x_anchor) over its sub-steps (:func:`wheelsoil.flexwheel.integrator.node_update`).
+    The anchor is the node's position carried ``anchor_lead`` seconds ahead at its present velocity, the mean of the
+    positions at which the n sub-steps of the next interval evaluate the force (Delta t (n - 1) / (2 n)): so a node
+    moving steadily receives exactly f on average, the force the spheres received the reaction of. Anchored at the
+    present position instead, a node moving down into the soil received f plus k v Delta t (n - 1) / (2 n): the
+    wheel was held up by more than the soil's reported force (issue 35: F_z below W at 1/6 g)."""
     node = nodes[u]
     f = vec3(0.0)
     stiff = 0.0
@@ -293,7 +301,7 @@ def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corn
                 stiff += bary[e, k] * stiffness[e]
     f_ext[node] = f
     k_ext[node] = stiff
-    x_anchor[node] = xw[node]
+    x_anchor[node] = xw[node] + anchor_lead * vw[node]
 
 
 @ti.kernel
@@ -314,7 +322,7 @@ def wheel_contacts(
     f_ext: nd_vec3, k_ext: nd_f64, x_anchor: nd_vec3, node_ref: nd_vec3, hub: nd_vec3, resultant: nd_vec3,
     # contact law
     e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, rolling: ti.i32, dt: ti.f64,
-    stats: nd_f64,
+    anchor_lead: ti.f64, stats: nd_f64,
 ):
     """One evaluation of every particle--wheel contact (phases A--D above, then the resultant).
 
@@ -400,7 +408,7 @@ def wheel_contacts(
     largest = 0.0
     for u in nodes:
         node_load(u, nodes, corner_start, corners, facet_start, facet_entries, keep, bary, f_wheel, m_wheel,
-                  stiffness, xw, tri, f_ext, k_ext, x_anchor)
+                  stiffness, xw, vw, tri, f_ext, k_ext, x_anchor, anchor_lead)
         ti.atomic_max(largest, (xw[nodes[u]] - node_ref[u]).norm_sqr())
     # resultant on the wheel: force and moment about the hub centre (serial sum: deterministic)
     ti.loop_config(serialize=True)
