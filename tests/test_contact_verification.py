@@ -145,7 +145,7 @@ def test_oblique_impact_gross_sliding():
     assert abs(w[0]) < 1e-9 and abs(w[2]) < 1e-9
 
 
-@pytest.mark.parametrize("law", ["cdt", "epsd"])
+@pytest.mark.parametrize("law", ["cdt", pytest.param("epsd", marks=pytest.mark.slow)])  # EPSD held at rest: fast
 def test_rolling_resistance_spin_decay(law):
     mu_r, r, g = 0.1, 0.01, 9.81
     pair = PairProperties(restitution=0.3, static_friction=0.8, rolling_friction=mu_r, rolling_model=law)
