@@ -70,6 +70,14 @@ from .surface import ContactSurface
 #: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
 #: or two places in practice: a face, or the corner between the tread and a grouser).
 HISTORY_SLOTS = 4
+def anchor_lead(interval: float, substeps: int) -> float:
+    """How far ahead [s], at its present velocity, a node's linearised contact force is anchored: Delta t (n - 1) /
+    (2 n), the mean time of the n sub-steps' force evaluations over the interval Delta t (each evaluates before it
+    moves the node). A node moving steadily then receives exactly the evaluated force on average
+    (:func:`.kernels.node_load`)."""
+    return interval * (substeps - 1) / (2 * substeps)
+
+
 #: The per-particle contact history arrays: contact normals, tangential displacements [m], rolling spring torques
 #: [N m] (EPSD pairs; zero under CDT) and the number of slots in use.
 HISTORY_KEYS = ("hist_n", "hist_xi", "hist_roll", "hist_count")
@@ -262,8 +270,7 @@ class WheelContact(Interaction):
         k.wheel_contacts_graph(
             *particles, self._n_active, *rest,
             self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
-            ROLLING_MODELS[self.pair.rolling_model], dt, dt * (self._last_substeps - 1) / (2 * self._last_substeps),
-            self._stats,
+            ROLLING_MODELS[self.pair.rolling_model], dt, anchor_lead(dt, self._last_substeps), self._stats,
         )
 
     # ------------------------------------------------------------------ measured quantities

@@ -169,3 +169,45 @@ def test_wheel_command_meshes_and_load_tests_a_preset(tmp_path, capsys):
     assert len((out / "load_test.csv").read_text().splitlines()) == 1 + 2 * 3
     assert "kN/m" in capsys.readouterr().out
     assert main(["wheel", "tractor", "--out", str(tmp_path / "x")]) == 2
+
+
+@pytest.mark.parametrize("lead", ["anchor_lead", "none"])
+def test_a_linearised_load_on_a_moving_wheel_delivers_its_evaluated_impulse(lead):
+    """The coupling hands each node f - k (x - x_a) for the sub-steps of a DEM interval (coupling.contact). A free
+    wheel moving steadily at v receives, over the interval, the impulse F dt only when x_a is the node's position
+    carried ahead by coupling.contact.anchor_lead; anchored where it stands, it receives F dt - k v dt^2 (n - 1) / 2
+    per node, the bias that held flexible wheels up by more than the soil's force (issue 35)."""
+    from wheelsoil.coupling.contact import anchor_lead
+
+    mesh, hub = build_wheel_mesh(COARSE_EXOMARS)
+    wheel = Structure(mesh, hub_nodes=hub, hub_mass=1.0, gravity=[0, 0, 0])
+    wheel.drive_hub(free_translation=[True, True, True], free_rotation=[True, True, True])
+    v = np.array([0.0, 0.0, -0.2])
+    wheel.set_hub_state(velocity=v)
+    wheel.set_state(velocities=np.tile(v, (mesh.n_nodes, 1)))
+    loaded = np.flatnonzero(mesh.nodes[:, 2] < mesh.nodes[:, 2].min() + 0.01)
+    interval, force, k = 1e-5, 0.02, 2e4  # k dt^2 / m ~ 4e-3 for these ~1e-3 kg nodes: the motion stays steady
+    n_sub = int(np.ceil(interval / wheel.stable_time_step * (1 - 1e-12)))
+    assert n_sub >= 3
+    a = wheel.device_arrays()
+    f = np.zeros((mesh.n_nodes, 3))
+    f[loaded, 2] = force
+    stiffness = np.zeros(mesh.n_nodes)
+    stiffness[loaded] = k
+    x0 = wheel.positions()
+    ahead = anchor_lead(interval, n_sub) if lead == "anchor_lead" else 0.0
+    a.k_ext.from_numpy(stiffness)
+    a.x_anchor.from_numpy(x0 + ahead * v)
+    mass = a.mass.to_numpy()
+    momentum = lambda: (mass[:, None] * wheel.velocities()).sum(0) + 1.0 * wheel.hub_velocity  # noqa: E731
+    p0 = momentum()
+    assert wheel.advance(interval, forces=f) == n_sub
+    impulse = momentum() - p0
+    expected = force * interval * len(loaded)
+    bias = k * abs(v[2]) * interval**2 * (n_sub - 1) / (2 * n_sub) * len(loaded)  # the standing anchor's extra push
+    assert bias > 0.2 * expected  # the test can tell the two apart
+    if lead == "anchor_lead":
+        assert impulse[2] == pytest.approx(expected, rel=0.02)  # second order: the nodes' own acceleration
+    else:
+        assert impulse[2] == pytest.approx(expected + bias, rel=0.02)
+    assert abs(impulse[0]) < 1e-9 * expected and abs(impulse[1]) < 1e-9 * expected
