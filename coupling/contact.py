@@ -70,17 +70,17 @@ from .surface import ContactSurface
 #: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
 #: or two places in practice: a face, or the corner between the tread and a grouser).
 HISTORY_SLOTS = 4
+#: The per-particle contact history arrays: contact normals, tangential displacements [m], rolling spring torques
+#: [N m] (EPSD pairs; zero under CDT) and the number of slots in use.
+HISTORY_KEYS = ("hist_n", "hist_xi", "hist_roll", "hist_count")
+
+
 def anchor_lead(interval: float, substeps: int) -> float:
     """How far ahead [s], at its present velocity, a node's linearised contact force is anchored: Delta t (n - 1) /
     (2 n), the mean time of the n sub-steps' force evaluations over the interval Delta t (each evaluates before it
     moves the node). A node moving steadily then receives exactly the evaluated force on average
     (:func:`.kernels.node_load`)."""
     return interval * (substeps - 1) / (2 * substeps)
-
-
-#: The per-particle contact history arrays: contact normals, tangential displacements [m], rolling spring torques
-#: [N m] (EPSD pairs; zero under CDT) and the number of slots in use.
-HISTORY_KEYS = ("hist_n", "hist_xi", "hist_roll", "hist_count")
 
 
 class WheelContact(Interaction):
@@ -327,8 +327,9 @@ class WheelContact(Interaction):
 
     def restore_state(self, scene: Scene, state: dict) -> None:
         """Continue from a :meth:`state` taken with the same wheel on ``scene``'s particles."""
+        # a checkpoint from before the sub-step count was kept: 1, as a fresh contact starts
         for key in self._STATE_SCALARS:
-            setattr(self, key, int(state.get(key, 1)) if key == "_last_substeps" else int(state[key]))
+            setattr(self, key, int(state.get(key, 1) if key == "_last_substeps" else state[key]))
         self._resultant.from_numpy(np.asarray(state["resultant"], float))
         if "hist_count" in state:
             self._attach(scene)

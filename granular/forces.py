@@ -160,9 +160,9 @@ def owner_contacts(
         if (candidates >> w) & 1:
             nw = wall_normal[w]
             gap = (xi_pos - wall_point[w]).dot(nw)
-            wall_rolling = ti.cast(wall_props[w, WALL_ROLLING], ti.i32)
             if gap < ri:
                 n = -nw
+                wall_rolling = ti.cast(wall_props[w, WALL_ROLLING], ti.i32)
                 roll = vec3(0.0, 0.0, 0.0)
                 if wall_rolling == ROLLING_EPSD:
                     roll = roll_wall[i, w]
