@@ -363,6 +363,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the semi-empirical model's shear: 'independent' (classical: each direction saturates on its "
                         "own displacement) or 'resultant' (the CMU lab's model: one strength, shared along the slip "
                         "velocity)")
+    p.add_argument("--domain", choices=("all", "driving"), default="all",
+                   help="rows to use: 'all' (default: braking, dragged and 90 deg rows included; the report counts "
+                        "each kind) or 'driving' (the classical subset: driving slip 0 <= i < 1 along the heading, "
+                        "|slip angle| <= 80 deg)")
     p.set_defaults(func=cmd_validate)
 
     soil_lab_command.add_parser(sub)

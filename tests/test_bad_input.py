@@ -75,7 +75,7 @@ def test_render_and_report_places_are_checked_before_work(tmp_path, a_file, caps
 @pytest.mark.parametrize("change, needle", [
     ("drop-responses", "no measured response in any row"),
     ("text-slip", "the condition 'slip' must be a number in every row; data row 4 holds 'abc'"),
-    ("negative-loads", "no row to fit: 27 of 27 rows lie outside the model's domain"),
+    ("negative-loads", "no row to fit in the domain 'all': 27 of 27 rows lie outside it"),
     ("missing-load", "the condition 'load' is missing (empty or NaN) in data row(s) [3]"),
 ])
 def test_measured_files_the_model_cannot_use(change, needle, measured_dir, tmp_path, capsys):
@@ -95,6 +95,27 @@ def test_measured_files_the_model_cannot_use(change, needle, measured_dir, tmp_p
         data.loc[2, "vertical_load_n"] = float("nan")
     path = tmp_path / "bad.csv"
     data.to_csv(path, index=False)
+    _refused(["validate", str(path), "--report", str(tmp_path / "report")], capsys, needle)
+
+
+@pytest.mark.parametrize("change, needle", [
+    ("sideways-without-travel-slip", "column 'travel_slip' in data row 2 (slip 1, slip_angle 90 deg, travel_slip nan"),
+    ("travel-slip-disagrees", "column 'slip' in data row 1 (slip 0.2, slip_angle 30 deg, travel_slip 0.5"),
+    ("slip-out-of-range", "column 'slip' in data row 3 (slip -1.5"),
+    ("angle-out-of-range", "column 'slip_angle' in data row 1 (slip 0.2, slip_angle 120 deg"),
+])
+def test_rows_whose_motion_the_model_cannot_be_told_are_refused(change, needle, tmp_path, capsys):
+    """wheelsoil's CSV format: a 90 deg row needs the slip against the travel speed; the two slips must agree."""
+    rows = {"slip": [0.2, 1.0, -0.5], "slip_angle_deg": [30.0, 90.0, 0.0], "vertical_load_N": [20.0, 20.0, 20.0],
+            "wheel_radius_m": [0.058] * 3, "wheel_width_m": [0.05] * 3, "drawbar_pull_N": [1.0, 2.0, -3.0]}
+    if change == "travel-slip-disagrees":
+        rows["travel_slip"] = [0.5, 0.5, -0.5]
+    elif change == "slip-out-of-range":
+        rows["slip"][2], rows["travel_slip"] = -1.5, [float("nan"), 0.5, float("nan")]
+    elif change == "angle-out-of-range":
+        rows["slip_angle_deg"][0] = 120.0
+    path = tmp_path / "rows.csv"
+    path.write_text(",".join(rows) + "\n" + "\n".join(",".join(str(v[k]) for v in rows.values()) for k in range(3)) + "\n")
     _refused(["validate", str(path), "--report", str(tmp_path / "report")], capsys, needle)
 
 

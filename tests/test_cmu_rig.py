@@ -109,6 +109,6 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
         grouser_count=np.array([g.grouser_count for g in geometry], float), group=np.full(n, "1g"),
         responses={q: np.full(n, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
         std={}, notes="conditions only")
-    data = load_cmu_trials(folder, driving_only=False)
+    data = load_cmu_trials(folder)
     pairs, unmatched = match_conditions(data, simulated)
     assert len(data) == 297 and unmatched.size == 0 and len(pairs) == 297

@@ -22,9 +22,10 @@ def test_driving_closed_form_and_limits():
     np.testing.assert_allclose(heading_slip_from_travel(j, 0.0), j, atol=1e-12)
     # the example of the rig's data: 60 deg, rim at 20 mm/s, carriage at 10 mm/s
     assert heading_slip_from_travel(0.5, 60.0) == pytest.approx(0.75)
-    # 90 deg: a turning wheel does not advance along its heading; a dragged one neither travels along it nor turns
+    # 90 deg: a turning wheel does not advance along its heading; a dragged one keeps -1, the limit along the angle
     assert np.all(heading_slip_from_travel([0.0, 0.3, -0.5], 90.0) == 1.0)
-    assert heading_slip_from_travel(-1.0, 90.0) == 0.0
+    assert heading_slip_from_travel(-1.0, 90.0) == -1.0
+    assert heading_slip_from_travel(-1.0, 90.0 - 1e-9) == -1.0
     # a wheel spinning in place stays at 1 at any angle; the sign of the angle does not matter
     assert heading_slip_from_travel(1.0, 30.0) == 1.0
     assert heading_slip_from_travel(0.4, -30.0) == pytest.approx(heading_slip_from_travel(0.4, 30.0))
@@ -60,7 +61,7 @@ def test_measured_rows_rim_and_carriage_speeds(measured_dir):
                 if abs(longitudinal_slip(v, rim, 1.0) - slip) > 0.02:
                     continue
                 direct = longitudinal_slip(v * np.cos(np.radians(beta)), rim, 1.0) if beta < 90 else (
-                    1.0 if rim > 0 else 0.0)
+                    1.0 if rim > 0 else -1.0)
                 assert heading_slip_from_travel(slip, beta) == pytest.approx(direct, abs=0.02), row
                 checked += 1
     assert checked > 250

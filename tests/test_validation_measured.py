@@ -29,8 +29,8 @@ def test_units_come_from_the_column_suffix(column, expected):
 
 def test_cmu_trials_in_si(measured_dir):
     folder = os.path.join(measured_dir, "cmu_3d_terramechanics")
-    everything = load_cmu_trials(folder, driving_only=False)
-    driving = load_cmu_trials(folder)
+    everything = load_cmu_trials(folder)
+    driving = load_cmu_trials(folder, domain="driving")
     raw_sinkage = np.concatenate([_raw(os.path.join(folder, f"{w}_wheel_trials.csv"), "sinkage_mm")
                                   for w in ("grouser", "smooth")])
     np.testing.assert_allclose(everything.responses["sinkage"], raw_sinkage * 1e-3)
@@ -47,6 +47,14 @@ def test_cmu_trials_in_si(measured_dir):
         kept = int(np.sum(driving.group == w))
         assert f"{w} wheel: {kept} of {len(angles)} rows kept" in driving.notes
         assert f"{int(np.sum(angles == 90.0))} at 90 deg" in driving.notes.split(f"{w} wheel: ")[1]
+    # every row kept by default, its kind of motion from its own rim and carriage speeds, its rig slip kept as given
+    rim, carriage, slip = (np.concatenate([_raw(os.path.join(folder, f"{w}_wheel_trials.csv"), c) for w in ("grouser", "smooth")])
+                           for c in ("rim_speed_mm_s", "carriage_speed_mm_s", "slip"))
+    kinds = everything.kinds()
+    np.testing.assert_array_equal(kinds == "dragged", rim == 0.0)
+    np.testing.assert_array_equal(kinds == "braking", (rim > 0.0) & (rim < 0.99 * carriage))
+    np.testing.assert_allclose(everything.travel_slip, slip)
+    assert "every row kept" in everything.notes and f"{int((rim == 0).sum())} dragged" not in driving.notes
 
 
 def test_digitised_points_in_si(measured_dir):
@@ -115,3 +123,26 @@ def test_wheelsoil_csv_round_trip_keeps_every_condition(tmp_path):
     assert set(np.unique(back.passes)) == {1.0, 2.0, 3.0}
     for q in ("drawbar_pull", "lateral_force", "sinkage", "torque"):
         np.testing.assert_allclose(back.responses[q], data.responses[q], rtol=1e-9, err_msg=q)
+
+
+def test_residuals_are_summarised_by_kind_of_motion_and_angle(measured_dir):
+    """An error that lives in one branch shows in that branch's row of the report and in no other."""
+    from wheelsoil.validation.residuals import residuals_by_group
+
+    data = load_cmu_trials(os.path.join(measured_dir, "cmu_3d_terramechanics"))
+    kinds = data.kinds()
+    braking = (kinds == "braking").astype(float)
+    rng = np.random.default_rng(3)
+    noise = rng.normal(0.0, 0.01, len(data))
+    rows = residuals_by_group({"classical": {"drawbar_pull": braking + noise}, "final": {"drawbar_pull": noise}}, data)
+    by = {(r["by"], r["group"]): r for r in rows}
+    assert by[("motion", "braking")]["classical"]["bias"] == pytest.approx(1.0, abs=0.01)
+    assert abs(by[("motion", "driving")]["classical"]["bias"]) < 0.01
+    assert abs(by[("motion", "braking")]["final"]["bias"]) < 0.01
+    assert sum(by[("motion", k)]["rows"] for k in ("driving", "braking", "dragged")) == len(data)
+    assert by[("slip_angle", "90")]["rows"] == int(np.sum(data.slip_angle == 90.0))
+    # a residual growing with slip inside the driving rows shows as that group's trend
+    trend = np.where(kinds == "driving", data.slip, 0.0)
+    rows = residuals_by_group({"final": {"drawbar_pull": trend}}, data)
+    driving = next(r for r in rows if r["group"] == "driving")
+    assert driving["final"]["slip_spearman"] == pytest.approx(1.0)

@@ -178,8 +178,11 @@ def test_trends_and_symmetry():
 
 @pytest.mark.parametrize("kwargs, match", [
     (dict(slip=1.0, load=50.0), r"slip\[0\] = 1.0 is out of range"),
-    (dict(slip=0.2, slip_angle=90.0, load=50.0), r"slip_angle\[0\] = 90.0"),
-    (dict(slip=[0.1, 0.2], load=[50.0, -1.0]), r"load\[1\] = -1.0 is out of range: allowed load > 0 N"),
+    (dict(slip=0.2, slip_angle=90.0, load=50.0), r"slip\[0\] = 0.2 .*at 90 deg give travel_slip"),
+    (dict(slip=0.2, slip_angle=95.0, load=50.0), r"slip_angle\[0\] = 95.0 .*-90 <= slip_angle <= 90"),
+    (dict(travel_slip=[0.2, 1.0], slip_angle=90.0, load=50.0), r"travel_slip\[1\] = 1.0 .*spinning in place"),
+    (dict(slip=0.2, travel_slip=0.5, slip_angle=30.0, load=50.0), r"slip\[0\] = 0.2 along the heading disagrees"),
+    (dict(slip=[0.1, 0.2], load=[50.0, -1.0]), r"load\[1\] = -1.0 is out of range: allowed 0 < load"),
     (dict(slip=0.2, load=50.0, gravity=float("nan")), r"gravity\[0\] = nan"),
 ])
 def test_bad_conditions_name_the_value(kwargs, match):

@@ -44,7 +44,7 @@ def model_responses(soil: SoilParameters, data: Measurements) -> dict[str, np.nd
         rows = np.all(wheels == key, axis=1)
         wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
         pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
-                       gravity=data.gravity[rows], passes=data.passes[rows])
+                       gravity=data.gravity[rows], passes=data.passes[rows], travel_slip=data.travel_slip[rows])
         for q in RESPONSES:
             out[q][rows] = pred[q]
     return out

@@ -20,7 +20,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
 from wheelsoil.parameters import cmu_k10
-from wheelsoil.slip import heading_slip_from_travel
+from wheelsoil.slip import WheelSpeeds, heading_slip_from_travel
 
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
@@ -117,6 +117,10 @@ class Measurements:
     for drawbar_pull, lateral_force, sinkage, torque (NaN where not measured) and ``std[name]`` where the
     data give a standard deviation. ``sinkage_relative``: the sinkage's zero is not the soil surface
     (e.g. the wheel's start position), so only its changes are comparable with a model.
+
+    ``slip`` is along the heading (architecture). ``travel_slip`` is the slip against the whole travel speed (the
+    CMU rig's), which alone describes a wheel at 90 deg (:class:`wheelsoil.slip.WheelSpeeds`); where a source does
+    not give it, it is derived from ``slip`` (NaN at 90 deg, where it cannot be).
     """
 
     name: str
@@ -134,10 +138,15 @@ class Measurements:
     notes: str = ""
     sinkage_relative: bool = False
     passes: np.ndarray | None = None
+    travel_slip: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.passes is None:
             self.passes = np.ones(len(self.slip))
+        if self.travel_slip is None:  # a condition holding text is named by check_measurements, not here
+            numeric = all(np.asarray(getattr(self, k)).dtype.kind in "fiu" for k in ("slip", "slip_angle"))
+            self.travel_slip = (travel_slip_from_heading(self.slip, self.slip_angle) if numeric
+                                else np.full(len(self.slip), np.nan))
 
     def __len__(self) -> int:
         return len(self.slip)
@@ -148,7 +157,33 @@ class Measurements:
         return Measurements(self.name, *(pick(getattr(self, k)) for k in (
             "slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")),
             responses={k: pick(v) for k, v in self.responses.items()}, std={k: pick(v) for k, v in self.std.items()},
-            notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes))
+            notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes),
+            travel_slip=pick(self.travel_slip))
+
+    def kinds(self) -> np.ndarray:
+        """Each row's kind of motion (:data:`ROW_KINDS`): "dragged" (the wheel does not turn, travel slip -1),
+        "braking" (it turns slower than it travels, -1 < travel slip < :data:`FREE_ROLLING_SLIP`) or "driving"
+        (faster, or free rolling), by the slip against the whole travel speed, as the rig sets it."""
+        s = self.travel_slip
+        return np.where(s <= -1.0, "dragged", np.where(s < FREE_ROLLING_SLIP, "braking", "driving"))
+
+
+#: The kinds of motion a row may hold (:meth:`Measurements.kinds`).
+ROW_KINDS = ("driving", "braking", "dragged")
+#: A row whose travel slip is above this is free rolling or driving, not braking: the CMU rig's free-rolling rows
+#: (rim speed set equal to the carriage's) record -0.003 to +0.003 from the carriage's speed jitter.
+FREE_ROLLING_SLIP = -0.01
+
+
+def travel_slip_from_heading(slip, slip_angle_deg) -> np.ndarray:
+    """The slip against the whole travel speed of rows given by their heading slip (NaN at 90 deg and where the
+    heading slip is missing or outside [-1, 1): those rows cannot say it)."""
+    i = np.asarray(slip, float)
+    beta = np.asarray(slip_angle_deg, float)
+    i, beta = np.broadcast_arrays(i, beta)
+    ok = np.isfinite(i) & np.isfinite(beta) & (i >= -1.0) & (i < 1.0) & (np.abs(beta) < 90.0)
+    out = WheelSpeeds.from_heading_slip(np.where(ok, i, 0.0), np.where(ok, beta, 0.0)).travel_slip
+    return np.where(ok, out, np.nan)
 
 
 #: The columns of a CMU trial file (after the unit suffix is split off).
@@ -157,19 +192,20 @@ CMU_COLUMNS = ("wheel", "steering_angle", "slip", "drawbar_pull", "lateral_force
 CMU_NOTES = "Pavlov (CMU), MIT licence; sinkage zero is the wheel's start position"
 
 
-def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurements:
+def load_cmu_file(path: str | Path, *, domain: str = "all") -> Measurements:
     """One CMU trial file (``grouser_wheel_trials.csv``, ``smooth_wheel_trials.csv`` or a file of the same
     columns): the wheel of each row from its ``wheel`` column (``grouser`` or ``smooth``).
 
     Slip is converted to wheelsoil's convention (:func:`wheelsoil.slip.heading_slip_from_travel`): the rig takes
     slip against the carriage's whole speed V, wheelsoil and its model against V's component along the heading,
     V cos(beta). At 60 deg the rig's 0.5 is 0.75 here; at 90 deg a turning wheel has slip 1 (it does not advance
-    along its heading) and a dragged one 0 (it neither advances nor turns).
+    along its heading) and a dragged one -1, as at every angle.
 
     The soil carries ``vertical_load``; sinkage is kept as recorded (the lab's zero is the wheel's start
-    position, not the soil surface, so only its changes are comparable). ``driving_only`` keeps rows with
-    0 <= slip < 1 below 90 deg (the model's driving branch): rows braking along the heading
-    (r omega < V cos beta), dragged wheels and every 90 deg row are dropped.
+    position, not the soil surface, so only its changes are comparable). ``domain`` (:data:`DOMAINS`): "all" keeps
+    every row; "driving" keeps rows with 0 <= slip < 1 below 90 deg (the classical driving branch, the subset
+    validated before braking and 90 deg were in the model): rows braking along the heading (r omega < V cos beta),
+    dragged wheels and every 90 deg row are dropped.
     The grouser count is not in the files: 0 for both (grousers enter through their height only where a
     model asks for it).
 
@@ -206,17 +242,37 @@ def load_cmu_file(path: str | Path, *, driving_only: bool = True) -> Measurement
              "vertical_load": opt("vertical_load_std")},
         notes=CMU_NOTES,
         sinkage_relative=True,
+        travel_slip=col("slip"),
     )
-    if driving_only:
-        keep, counts = _driving_rows(data)
-        data = data.select(keep)
-        data.notes = f"{CMU_NOTES}; {counts}"
+    data, counts = in_domain(data, domain)
+    data.notes = f"{CMU_NOTES}; {counts}"
     return data
 
 
+#: The row sets ``wheelsoil validate --domain`` may keep: every row, or the classical driving branch.
+DOMAINS = ("all", "driving")
+
+
+def row_counts(data: Measurements) -> str:
+    """A sentence counting the rows by kind of motion (:meth:`Measurements.kinds`) and those at 90 deg."""
+    kinds = data.kinds()
+    counts = ", ".join(f"{int((kinds == k).sum())} {k}" for k in ROW_KINDS)
+    return f"{len(data)} rows: {counts}; {int((np.abs(data.slip_angle) >= 90.0).sum())} of them at 90 deg"
+
+
+def in_domain(data: Measurements, domain: str) -> tuple[Measurements, str]:
+    """The rows of ``domain`` (:data:`DOMAINS`) and a sentence counting what was kept and left out."""
+    if domain not in DOMAINS:
+        raise WheelsoilInputError(f"domain {domain!r}: choose one of {list(DOMAINS)}")
+    if domain == "all":
+        return data, f"every row kept ({row_counts(data)})"
+    keep, counts = _driving_rows(data)
+    return data.select(keep), counts
+
+
 def _driving_rows(data: Measurements) -> tuple[np.ndarray, str]:
-    """The rows on the model's driving branch (0 <= slip < 1 along the heading, below 90 deg) and a sentence counting
-    the rows left out, by kind."""
+    """The rows on the classical driving branch (0 <= slip < 1 along the heading, below 90 deg) and a sentence
+    counting the rows left out, by kind."""
     sideways = np.abs(data.slip_angle) >= 90.0
     braking = ~sideways & (data.slip < 0.0)
     keep = ~sideways & ~braking & (data.slip < 1.0)
@@ -227,17 +283,14 @@ def _driving_rows(data: Measurements) -> tuple[np.ndarray, str]:
     return keep, counts
 
 
-def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measurements:
+def load_cmu_trials(folder: str | Path, *, domain: str = "all") -> Measurements:
     """The CMU 3D-terramechanics trials of a folder: both wheels' files (``grouser_wheel_trials.csv``,
     ``smooth_wheel_trials.csv``) read by :func:`load_cmu_file` into one set."""
     folder = Path(folder)
     parts, notes = [], [CMU_NOTES]
     for wheel in ("grouser", "smooth"):
-        part = load_cmu_file(folder / f"{wheel}_wheel_trials.csv", driving_only=False)
-        if driving_only:
-            keep, counts = _driving_rows(part)
-            part = part.select(keep)
-            notes.append(f"{wheel} wheel: {counts}")
+        part, counts = in_domain(load_cmu_file(folder / f"{wheel}_wheel_trials.csv"), domain)
+        notes.append(f"{wheel} wheel: {counts}")
         parts.append(part)
     cat = lambda key: np.concatenate([getattr(m, key) for m in parts])  # noqa: E731
     return Measurements(
@@ -245,7 +298,7 @@ def load_cmu_trials(folder: str | Path, *, driving_only: bool = True) -> Measure
                                                     "grouser_height", "grouser_count", "group")),
         responses={q: np.concatenate([m.responses[q] for m in parts]) for q in parts[0].responses},
         std={q: np.concatenate([m.std[q] for m in parts]) for q in parts[0].std},
-        notes="; ".join(notes), sinkage_relative=True, passes=cat("passes"))
+        notes="; ".join(notes), sinkage_relative=True, passes=cat("passes"), travel_slip=cat("travel_slip"))
 
 
 def load_digitised(path: str | Path) -> Measurements:
@@ -272,7 +325,7 @@ GENERIC_COLUMNS = {
     "slip": "slip", "slip_angle": "slip_angle_deg", "load": "vertical_load_N", "gravity": "gravity_m_s2",
     "radius": "wheel_radius_m", "width": "wheel_width_m", "grouser_height": "grouser_height_m",
     "grouser_count": "grouser_count", "drawbar_pull": "drawbar_pull_N", "lateral_force": "lateral_force_N",
-    "sinkage": "sinkage_m", "torque": "torque_Nm", "passes": "passes",
+    "sinkage": "sinkage_m", "torque": "torque_Nm", "passes": "passes", "travel_slip": "travel_slip",
 }
 
 
@@ -282,7 +335,7 @@ def save_measurements(data: Measurements, path: str | Path) -> Path:
     from wheelsoil.provenance import atomic_output
 
     cols = {GENERIC_COLUMNS[k]: getattr(data, k) for k in ("slip", "slip_angle", "load", "gravity", "passes", "radius",
-                                                           "width", "grouser_height", "grouser_count")}
+                                                           "width", "grouser_height", "grouser_count", "travel_slip")}
     cols |= {GENERIC_COLUMNS[q]: data.responses[q] for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")}
     cols["group"] = data.group
     rows = [",".join(cols)] + [",".join(str(v[k]) if isinstance(v[k], str) else f"{float(v[k]):.10g}"
@@ -306,6 +359,7 @@ def load_generic(path: str | Path, name: str | None = None) -> Measurements:
         group=t.columns["group"] if "group" in t.columns else np.full(n, "all"),
         responses={q: get(q, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
         notes=f"read from {path}", passes=get("passes", 1.0),
+        travel_slip=t.columns["travel_slip"] if "travel_slip" in t.columns else None,
     )
 
 
@@ -337,8 +391,10 @@ def load_sweep_summary(path: str | Path) -> Measurements:
     group = np.array([gravity_label(v, moon="moon", other="g{g:.3g}") for v in g])
     col = lambda key: t[key].to_numpy(float)  # noqa: E731
     slip = col("slip_set")
+    travel_slip = None
     if "slip_speed" in t.columns:
         travel = t["slip_speed"].astype(str).to_numpy() == "travel"
+        travel_slip = np.where(travel, slip, travel_slip_from_heading(slip, col("slip_angle_set")))
         slip = np.where(travel, heading_slip_from_travel(slip, col("slip_angle_set")), slip)
     return Measurements(
         name=path.parent.name, slip=slip, slip_angle=col("slip_angle_set"), load=col("load_set"),
@@ -347,6 +403,7 @@ def load_sweep_summary(path: str | Path) -> Measurements:
         responses={q: col(f"{src}_mean") for q, src in SIMULATED_RESPONSES.items()},
         std={q: col(f"{src}_std") for q, src in SIMULATED_RESPONSES.items()},
         notes=f"{len(t)} DEM-FEM runs of the wheelsoil sweep summarised in {path}; sinkage is the tread sinkage",
+        travel_slip=travel_slip,
     )
 
 
@@ -373,11 +430,37 @@ def check_measurements(data: Measurements, source) -> Measurements:
         if missing.size:
             raise WheelsoilInputError(f"{source}: the condition {key!r} is missing (empty or NaN) in data row(s) "
                                       f"{(missing + 1)[:10].tolist()}{' ...' if missing.size > 10 else ''}")
+    _check_motion(data, source)
     measured = [q for q, v in data.responses.items() if np.isfinite(np.asarray(v, float)).any()]
     if not measured:
         raise WheelsoilInputError(f"{source}: no measured response in any row (columns such as drawbar_pull_N, "
                                   "lateral_force_N, sinkage_m, torque_Nm): nothing to validate against")
     return data
+
+
+def _check_motion(data: Measurements, source) -> None:
+    """Refuse rows whose motion the model cannot be told: slip or steering angle out of range, a row at 90 deg
+    without the slip against the travel speed (``travel_slip``), or a travel slip that disagrees with the heading
+    slip of the same row."""
+    slip, beta, travel = (np.asarray(getattr(data, k), float) for k in ("slip", "slip_angle", "travel_slip"))
+    given = np.isfinite(travel)
+    heading = np.where(given, WheelSpeeds.from_travel_slip(np.where(given, travel, 0.0), beta).heading_slip, np.nan)
+    for column, bad, allowed in (
+        ("slip_angle", ~(np.abs(beta) <= 90.0), "-90 <= slip_angle <= 90 deg"),
+        ("slip", ~((slip >= -1.0) & (slip <= 1.0)), "-1 <= slip <= 1"),
+        ("travel_slip", given & ~((travel >= -1.0) & (travel < 1.0)), "-1 <= travel_slip < 1"),
+        ("travel_slip", ~given & (np.abs(beta) >= 90.0),
+         "a number at 90 deg: the slip along the heading cannot say how fast the wheel slides sideways"),
+        ("slip", ~given & (slip >= 1.0), "slip < 1 (a wheel spinning in place) unless travel_slip says it travels"),
+        ("slip", given & ~(np.abs(slip - heading) <= 1e-6),
+         "the heading slip of the row's travel_slip and steering angle"),
+    ):
+        rows = np.flatnonzero(bad)
+        if rows.size:
+            k = rows[0]
+            raise WheelsoilInputError(
+                f"{source}: column {column!r} in data row {k + 1} (slip {slip[k]:g}, slip_angle {beta[k]:g} deg, "
+                f"travel_slip {travel[k]:g}; {rows.size} such row(s)): allowed {allowed}")
 
 
 def load_measurements(path: str | Path) -> Measurements:

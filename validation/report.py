@@ -23,6 +23,7 @@ from .discovery import (
     model_responses,
 )
 from .measured import Measurements
+from .residuals import residuals_by_group
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
 
@@ -46,7 +47,7 @@ def verdict_lines(findings: dict) -> list[str]:
                      f"residual) — {c['source']}")
         close = [r for r in findings["steps"][c["step"]].get("rivals", []) if r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
         if close:
-            lines.append(f"  but a generic drift fits about as well in its place: "
+            lines.append("  but a generic drift fits about as well in its place: "
                          + "; ".join(f"{r['description']} (ΔBIC {r['bic_vs_accepted']:+.1f} against it)" for r in close)
                          + f"; named because no drift fits better by more than {RIVAL_MARGIN:g}")
     for c in findings["partial"]:
@@ -158,6 +159,30 @@ def plot_candidates(findings: dict, path: Path) -> None:
     _save(fig, path)
 
 
+def _row_residuals(soil, d: Discovery, data: Measurements) -> dict[str, np.ndarray]:
+    """(model - measured) / training scale per response over every row (training and held out; NaN unmeasured)."""
+    pred = model_responses(soil, data)
+    return {q: (pred[q] - data.responses[q]) / d.scales[q] for q in d.responses}
+
+
+def _group_lines(groups: list[dict]) -> list[str]:
+    """The report's table of residuals by kind of motion and by steering angle."""
+    if not groups:
+        return []
+    lines = ["### By kind of motion and steering angle", "",
+             "Every row (training and held out), residual normalised as above: mean (bias) and RMS, classical → final, "
+             "and the final residual's rank correlation with slip inside the group (– with fewer than 4 rows).", "",
+             "| group | response | rows | bias, classical → final | RMS, classical → final | trend with slip |",
+             "|---|---|---|---|---|---|"]
+    for g in groups:
+        c, f = g["classical"], g["final"]
+        rho = "–" if f["slip_spearman"] is None else f"{f['slip_spearman']:+.2f}"
+        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
+        lines.append(f"| {label} | {g['response']} | {g['rows']} | {c['bias']:+.3f} → {f['bias']:+.3f} | "
+                     f"{c['rms']:.3f} → {f['rms']:.3f} | {rho} |")
+    return lines + [""]
+
+
 def _parameter_rows(table: list[dict]) -> list[str]:
     out = ["| parameter | value | std. error | range | at a bound | identified |", "|---|---|---|---|---|---|"]
     for r in table:
@@ -174,6 +199,8 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
     out.mkdir(parents=True, exist_ok=True)
     findings = {"title": title, "data": data.name, "rows": len(data), "notes": data.notes, "command": command,
                 "excluded": excluded, **d.to_dict(), **(extra or {}), "provenance": provenance()}
+    findings["residuals_by_group"] = residuals_by_group(
+        {"classical": _row_residuals(d.baseline.soil, d, data), "final": _row_residuals(d.final.soil, d, data)}, data)
     plot_fits(findings, d, data, heldout, out / "fits.png")
     plot_residuals(findings, d, data, out / "residuals.png")
     if findings["steps"]:
@@ -183,7 +210,7 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
              f"Fitted responses: {', '.join(d.responses)}; {d.n_train} training and {d.n_heldout} held-out "
              "conditions; residuals normalised by the training data's spread.", ""]
     if excluded:
-        lines += [f"Excluded: {excluded}", ""]
+        lines += [f"Rows and responses: {excluded}", ""]
     if findings.get("shear_form", "independent") != "independent":
         lines += [f"Shear form: {findings['shear_form']} (the classical model and every candidate share it; "
                   "`--shear-form`)", ""]
@@ -206,7 +233,8 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
               "→ final model:", "", "| response | classical p | final p |", "|---|---|---|"]
     lof = findings["lack_of_fit"]
     lines += [f"| {q} | {lof['baseline'][q]['p_value']:.2g} | {lof['final'][q]['p_value']:.2g} |" for q in d.responses]
-    lines += ["", "![](residuals.png)", "", "## Forward selection", "",
+    lines += ["", "![](residuals.png)", ""] + _group_lines(findings["residuals_by_group"])
+    lines += ["## Forward selection", "",
               f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out gain is "
               f"positive and exceeds {GAIN_SIGMAS:g} bootstrap standard deviation(s), its parameter is inside its "
               f"physical range and of the mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of "

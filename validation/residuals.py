@@ -11,6 +11,9 @@ is systematic rather than noise.
   sum of squares the regression explains beyond its noise expectation p s^2 is the *systematic residual*: the part
   of the misfit a smooth function of the conditions would remove. A mechanism that is the cause of a misfit
   removes it; one that only resembles it leaves part of it (:mod:`.discovery` uses both).
+* :func:`residuals_by_group`: bias and RMS of each response's residual within each kind of motion (driving,
+  braking, dragged) and each steering angle, with the trend against slip inside the group, so an error that lives in
+  one branch is not averaged away by the others.
 * :func:`unexplained_trends`: for each response whose lack of fit is significant, the conditions whose terms carry
   most of it (partial sums of squares), with their shares and the Spearman trend: "error trends with X".
 """
@@ -45,6 +48,39 @@ def residual_trends(residuals: dict[str, np.ndarray], data: Measurements, rows: 
             rho, p = spearmanr(x, res)
             out.append({"response": q, "condition": c, "spearman": float(rho), "p_value": float(p)})
     return sorted(out, key=lambda r: r["p_value"])
+
+
+def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measurements) -> list[dict]:
+    """Each model's residual per response within each row group: the kinds of motion
+    (:meth:`~.measured.Measurements.kinds`) and the steering angles (rounded to 0.1 deg).
+
+    models: model name -> response -> residual over all rows (NaN where unmeasured). Returns one dict per (group,
+    response): "by" ("motion" or "slip_angle"), "group", "response", "rows", and per model "bias", "rms" and
+    "slip_spearman" (the residual's rank correlation with the heading slip inside the group; None with fewer than 4
+    rows or one slip)."""
+    out = []
+    groups = [("motion", k, data.kinds() == k) for k in ("driving", "braking", "dragged")]
+    angles = np.round(np.asarray(data.slip_angle, float), 1)
+    groups += [("slip_angle", f"{a:g}", angles == a) for a in np.unique(angles)]
+    responses = next(iter(models.values())).keys() if models else ()
+    for by, group, mask in groups:
+        for q in responses:
+            row = {"by": by, "group": group, "response": q}
+            for name, res in models.items():
+                r = res[q]
+                ok = mask & np.isfinite(r)
+                row["rows"] = int(ok.sum())
+                if not ok.any():
+                    break
+                rho = None
+                slip = np.asarray(data.slip, float)[ok]
+                if ok.sum() >= 4 and np.ptp(slip) > 0:
+                    rho = float(spearmanr(slip, r[ok])[0])
+                row[name] = {"bias": float(np.mean(r[ok])), "rms": float(np.sqrt(np.mean(r[ok] ** 2))),
+                             "slip_spearman": rho}
+            if row["rows"]:
+                out.append(row)
+    return out
 
 
 def _design(x: dict[str, np.ndarray]) -> tuple[np.ndarray, list[tuple[str, ...]]]:

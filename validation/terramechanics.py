@@ -55,11 +55,13 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY
 
+from wheelsoil.slip import WheelSpeeds
+
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
 
 __all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
-           "side_bulldozing_force", "bulldozing_force", "grouser_forces", "resultant_shear", "QUADRATURE_POINTS",
+           "side_bulldozing_force", "bulldozing_force", "grouser_forces", "janosi_hanamoto", "resultant_shear", "QUADRATURE_POINTS",
            "gauss_legendre"]
 
 
@@ -227,21 +229,49 @@ class RigidWheel:
             raise WheelsoilInputError(f"grouser_count = {self.grouser_count!r} must be a whole number >= 0")
 
 
-def _conditions(slip, slip_angle, load, gravity, passes=1.0):
-    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (slip, slip_angle, load, gravity, passes)))
-    slip, beta_deg, load, gravity, passes = (a.ravel().copy() for a in arrays)
+def _conditions(slip, slip_angle, load, gravity, passes=1.0, travel_slip=None):
+    """Conditions broadcast to one shape and checked (bad input named with its row and the allowed range), and the
+    wheel's speeds in velocity components (:class:`~wheelsoil.slip.WheelSpeeds`): from ``travel_slip`` (the slip
+    against the whole travel speed, the CMU rig's) in rows where it is given and finite, else from ``slip`` (along
+    the heading). Returns (shape, heading slip, beta [rad], load, gravity, passes, travel slip)."""
+    if slip is None and travel_slip is None:
+        raise WheelsoilInputError("give the slip along the heading (slip) or against the travel speed (travel_slip)")
+    travel_given = travel_slip is not None
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (
+        np.nan if slip is None else slip, slip_angle, load, gravity, passes, np.nan if travel_slip is None else travel_slip)))
+    slip, beta_deg, load, gravity, passes, travel = (a.ravel().copy() for a in arrays)
+    has_travel = np.isfinite(travel)
+    sideways = np.abs(beta_deg) >= 90.0
     for name, a, ok, allowed in (
-        ("slip", slip, (slip >= -1.0) & (slip < 1.0), "-1 <= slip < 1"),
-        ("slip_angle", beta_deg, np.abs(beta_deg) < 90.0, "-90 < slip_angle < 90 deg"),
-        ("load", load, load > 0.0, "load > 0 N"),
-        ("gravity", gravity, gravity > 0.0, "gravity > 0 m/s^2"),
-        ("passes", passes, passes >= 1.0, "passes >= 1"),
+        ("slip_angle", beta_deg, np.abs(beta_deg) <= 90.0, "-90 <= slip_angle <= 90 deg"),
+        ("travel_slip", travel, ~has_travel | ((travel >= -1.0) & (travel < 1.0)),
+         "-1 <= travel_slip < 1 (1: a wheel spinning in place)"),
+        ("slip", slip, has_travel | ((slip >= -1.0) & (slip < 1.0) & ~sideways),
+         "-1 <= slip < 1 below 90 deg; at 90 deg give travel_slip (the heading slip cannot say how fast the wheel "
+         "slides sideways)"),
+        ("load", load, (load > 0.0) & (load < np.inf), "0 < load < inf N"),
+        ("gravity", gravity, (gravity > 0.0) & (gravity < np.inf), "0 < gravity < inf m/s^2"),
+        ("passes", passes, (passes >= 1.0) & (passes < np.inf), "passes >= 1"),
     ):
-        bad = ~(np.isfinite(a) & ok)
+        bad = ~ok  # NaN fails every comparison: a missing value is out of range (NaN travel_slip means "not given")
         if bad.any():
             k = int(np.argmax(bad))
             raise WheelsoilInputError(f"{name}[{k}] = {float(a[k])!r} is out of range: allowed {allowed}")
-    return arrays[0].shape, slip, np.radians(beta_deg), load, gravity, passes
+    travel = np.where(has_travel, travel, 0.0)
+    if travel_given:  # the heading slip the travel slip gives, checked against one given with it
+        heading = WheelSpeeds.from_travel_slip(travel, beta_deg).heading_slip
+        both = has_travel & np.isfinite(slip)
+        off = both & ~np.isclose(slip, heading, rtol=0.0, atol=1e-9)
+        if off.any():
+            k = int(np.argmax(off))
+            raise WheelsoilInputError(
+                f"slip[{k}] = {slip[k]:g} along the heading disagrees with travel_slip[{k}] = {travel[k]:g} at "
+                f"{beta_deg[k]:g} deg, which gives {heading[k]:.6g}; give one or make them agree")
+        slip = np.where(has_travel, heading, slip)
+    if not has_travel.all():
+        travel = np.where(has_travel, travel, WheelSpeeds.from_heading_slip(
+            np.where(has_travel, 0.0, slip), np.where(has_travel, 0.0, beta_deg)).travel_slip)
+    return arrays[0].shape, slip, np.radians(beta_deg), load, gravity, passes, travel
 
 
 def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
@@ -251,8 +281,13 @@ def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
 
 
 def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity,
-                   extra_pressure=0.0, passes=1.0, vertical_only: bool = False) -> dict:
+                   extra_pressure=0.0, passes=1.0, vertical_only: bool = False, travel_slip=None) -> dict:
     """Soil forces on the wheel at a given sinkage (arrays broadcast together; ``slip_angle`` in degrees).
+
+    ``slip`` is along the heading (it sets theta_m, the sinkage exponent and slip drifts); the shear displacements
+    take the wheel's speeds in velocity components (:class:`~wheelsoil.slip.WheelSpeeds`), from ``travel_slip``
+    (against the whole travel speed) where it is given and finite, else from ``slip``: at 90 deg give
+    ``travel_slip`` (:func:`predict` derives ``slip`` from it).
 
     ``extra_pressure`` [Pa] is added to the normal stress over the whole contact, as seed 002 eq. 17 adds its
     oscillating term A_gamma sin(omega t + Phi) (:mod:`wheelsoil.validation.oscillation`); 0 by default.
@@ -262,9 +297,11 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     contact angles theta_f, theta_m, theta_r [rad]; with ``vertical_only`` just vertical_force (what the
     sinkage solve of :func:`predict` needs, about a third cheaper).
     """
-    z, i, beta_deg, g, p_extra, n_p = (a.ravel() for a in np.broadcast_arrays(
-        *(np.asarray(v, float) for v in (sinkage, slip, slip_angle, gravity, extra_pressure, passes))))
+    z, i, beta_deg, g, p_extra, n_p, s_travel = (a.ravel() for a in np.broadcast_arrays(*(np.asarray(v, float) for v in (
+        sinkage, slip, slip_angle, gravity, extra_pressure, passes, np.nan if travel_slip is None else travel_slip))))
     beta = np.radians(beta_deg)
+    speeds = _wheel_speeds(i, beta_deg, s_travel)
+    i = np.where(np.isfinite(s_travel), speeds.heading_slip, i)  # the heading slip the speeds give
     r, b = effective_radius(soil, wheel), wheel.width
     drifted = lambda name: soil.drifted(name, i, beta, g, n_p)  # noqa: E731  (the soil's own unless drifting)
     phi = np.radians(drifted("friction_angle"))
@@ -294,25 +331,23 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
     tf = theta_f[:, None]
-    driving = i[:, None] >= 0.0
-    # seed 003 eq. 12 (driving / braking) and eq. 16
+    rim, along, across = speeds.rim[:, None], speeds.along[:, None], np.abs(speeds.across)[:, None]
     # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
     eta = np.clip(soil.soil_flow + soil.soil_flow_gravity * (1.0 - g / EARTH_GRAVITY), 0.0, 0.95)
-    sweep = (tf - theta) * (1.0 - eta[:, None])
-    jx = np.where(driving, r * (sweep - (1.0 - i[:, None]) * (np.sin(tf) - np.sin(theta))),
-                  r * (sweep - (np.sin(tf) - np.sin(theta)) / (1.0 + i[:, None])))
+    # seed 003 eqs. 11 and 14 in velocity components, j = int_theta^theta_f (slip velocity) d theta' / omega: with
+    # v_x = (1 - i) r omega (driving) or r omega / (1 + i) (braking) these are eqs. 12 and 16 on both branches
+    jx = r * _per_rim((tf - theta) * (1.0 - eta[:, None]) * rim - along * (np.sin(tf) - np.sin(theta)), rim)
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
     k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
 
-    def lateral_displacement():  # seed 003 eq. 16
-        jy = np.where(driving, r * (1.0 - i[:, None]) * (tf - theta), r * (tf - theta) / (1.0 + i[:, None]))
-        return jy * np.abs(np.tan(beta))[:, None]
+    def lateral_displacement():  # seed 003 eq. 14: j_y = (theta_f - theta) |v_y| / omega, eq. 16 where tan beta is finite
+        return r * _per_rim((tf - theta) * across, rim)
 
     resultant = soil.shear_form == "resultant"
     if resultant:
-        tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(), k_x, i, beta, eta, theta)
+        tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(), k_x, speeds, eta, theta)
     else:
-        tau_x = strength * (1.0 - np.exp(-jx / k_x))
+        tau_x = janosi_hanamoto(strength, jx, k_x)
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
     grousers = bool(wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0)
     if grousers:
@@ -322,7 +357,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         return {"vertical_force": fz}
     if not resultant:  # the lateral shear is not needed for the sinkage solve
         shear_modulus_y = np.broadcast_to(shear_modulus_y, i.shape)[:, None]
-        tau_y = strength * (1.0 - np.exp(-lateral_displacement() / shear_modulus_y))
+        tau_y = janosi_hanamoto(strength, lateral_displacement(), shear_modulus_y)
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
@@ -348,17 +383,48 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     }
 
 
-def resultant_shear(strength, jx, jy, k_x, slip, beta, soil_flow, theta):
+def _wheel_speeds(slip, slip_angle_deg, travel_slip) -> WheelSpeeds:
+    """The wheel's speeds from the travel slip in rows where it is finite, else from the heading slip."""
+    given = np.isfinite(travel_slip)
+    if given.all():
+        return WheelSpeeds.from_travel_slip(travel_slip, slip_angle_deg)
+    heading = WheelSpeeds.from_heading_slip(np.where(given, 0.0, slip), np.where(given, 0.0, slip_angle_deg))
+    if not given.any():
+        return heading
+    travel = WheelSpeeds.from_travel_slip(np.where(given, travel_slip, 0.0), slip_angle_deg)
+    return WheelSpeeds(*(np.where(given, getattr(travel, k), getattr(heading, k)) for k in ("rim", "along", "across")))
+
+
+def _per_rim(displacement_rate, rim):
+    """displacement_rate / rim, the integral over the contact of a slip velocity divided by omega [-]: a wheel
+    that does not turn (rim = 0) slides without end, +-inf, the limit of a vanishing rim speed, so the shear it
+    meets is fully mobilised; 0 where nothing slides (a component with no sliding speed: along the heading of a
+    wheel dragged sideways at 90 deg). The independent shear form is discontinuous there (an arbitrarily slow
+    tangential slide at 89.99 deg already mobilises the full strength along x); the resultant form, which shares
+    one strength along the slip velocity, is not."""
+    rim = np.broadcast_to(rim, np.shape(displacement_rate))
+    turning = rim > 0.0
+    sliding = np.where(displacement_rate == 0.0, 0.0, np.copysign(np.inf, displacement_rate))
+    return np.where(turning, displacement_rate / np.where(turning, rim, 1.0), sliding)
+
+
+def janosi_hanamoto(strength, displacement, modulus):
+    """Janosi--Hanamoto shear (seed 003 eqs. 9 and 13) with the sign of the displacement: tau = (c + sigma tan phi)
+    sign(j) (1 - exp(-|j| / k)) [Pa], so |tau| never exceeds the Mohr--Coulomb strength (seed 003 eq. 10) where the
+    soil is sheared backwards (braking, Wong & Reece 1967b) and a sliding wheel's infinite j gives the full
+    strength."""
+    return strength * np.sign(displacement) * -np.expm1(-np.abs(displacement) / modulus)
+
+
+def resultant_shear(strength, jx, jy, k_x, speeds: WheelSpeeds, soil_flow, theta):
     """The CMU lab's shear (``tau_t.m``, ``tau_l.m``; module docstring): strength [Pa] mobilised by sqrt(j_x^2 +
-    j_y^2) / k_x [m / m] along the slip velocity. Rows: conditions (slip, beta [rad], soil flow eta); columns: theta
-    [rad]. Returns (tau_x, tau_y) [Pa], tau_y a magnitude (its sign is -sign(beta))."""
-    i = slip[:, None]
-    # the slip velocity in units of r omega (v_jt.m): v_x = (1 - i) r omega driving, r omega / (1 + i) braking
-    to_rim = np.where(i >= 0.0, 1.0 - i, 1.0 / (1.0 + i))
-    v_t = (1.0 - soil_flow)[:, None] - to_rim * np.cos(theta)
-    v_l = to_rim * np.abs(np.tan(beta))[:, None]
+    j_y^2) / k_x [m / m] along the slip velocity. Rows: conditions (the wheel's speeds, soil flow eta); columns:
+    theta [rad]. Returns (tau_x, tau_y) [Pa], tau_y a magnitude (its sign is -sign(beta))."""
+    # the slip velocity under the rim (v_jt.m, with the soil's own flow), in the speeds' units
+    v_t = (speeds.rim * (1.0 - soil_flow))[:, None] - speeds.along[:, None] * np.cos(theta)
+    v_l = np.broadcast_to(np.abs(speeds.across)[:, None], v_t.shape)
     speed = np.hypot(v_t, v_l)
-    mobilised = strength * (1.0 - np.exp(-np.hypot(jx, jy) / k_x)) / np.where(speed > 0.0, speed, 1.0)
+    mobilised = strength * -np.expm1(-np.hypot(jx, jy) / k_x) / np.where(speed > 0.0, speed, 1.0)
     return mobilised * v_t, mobilised * v_l
 
 
@@ -405,9 +471,15 @@ def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gr
     return fx, fz, torque
 
 
-def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, load, gravity=EARTH_GRAVITY, passes=1.0,
-            max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10, max_iterations: int = 200) -> dict:
+def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.0, load, gravity=EARTH_GRAVITY,
+            passes=1.0, travel_slip=None, max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10,
+            max_iterations: int = 200) -> dict:
     """Steady-state forces and sinkage for each condition (arrays broadcast together).
+
+    The wheel's motion: ``slip`` along the heading (architecture), ``travel_slip`` against the whole travel speed
+    (the CMU rig's convention), or both (they must agree where both are finite). Below 90 deg either will do; at
+    90 deg only the travel slip says how fast the wheel slides sideways against its rim speed. NaN in
+    ``travel_slip`` falls back on ``slip`` row by row.
 
     Solves F_z(z) = W for the sinkage z in (0, max_sinkage_ratio r) (F_z rises with z) by the Illinois
     variant of false position, vectorised over conditions, to |F_z - W| <= tolerance W; then evaluates
@@ -415,11 +487,12 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, lo
     lateral_force, vertical_force [N], torque [N m], theta_f, theta_m, theta_r [rad], and ``supported``
     (False where even z = max_sinkage_ratio r cannot carry W; those rows hold that sinkage).
     """
-    shape, i, beta, load, g, n_p = _conditions(slip, slip_angle, load, gravity, passes)
+    shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
     beta_deg = np.degrees(beta)
 
     def excess(z):
-        return contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, vertical_only=True)["vertical_force"] - load
+        return contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, vertical_only=True,
+                              travel_slip=s_travel)["vertical_force"] - load
 
     lo, f_lo = np.zeros_like(load), -load.copy()
     hi = np.full_like(load, max_sinkage_ratio * wheel.radius)
@@ -447,7 +520,7 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip, slip_angle=0.0, lo
     else:
         raise RuntimeError(f"sinkage did not converge in {max_iterations} iterations")
     z = np.where(supported, z, max_sinkage_ratio * wheel.radius)
-    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p)
+    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel)
     out["sinkage"] = z
     out["supported"] = supported
     return {k: np.reshape(v, shape) for k, v in out.items()}

@@ -12,38 +12,49 @@ from wheelsoil.errors import WheelsoilInputError
 from .calibration import normalised_residuals
 from .crossval import cross_validate, levels, write_cross_validation
 from .discovery import RESPONSES, discover, holdout_mask
-from .measured import Measurements, load_measurements, save_measurements
+from .measured import DOMAINS, Measurements, load_measurements, row_counts, save_measurements
 from .terramechanics import SoilParameters
 from .model_file import load_model, save_model, write_predictions
 from .report import verdict_lines, write_report
 from .synthetic import HIDDEN_RANGES, draw_hidden_effect, synthetic_measurements
 
-#: The model's steering-angle domain: lateral shear displacement ~ tan(beta).
+#: ``--domain driving``'s steering-angle limit: the classical subset, validated before the kinematics were written in
+#: velocity components (its lateral shear displacement went as tan(beta)).
 MAX_SLIP_ANGLE = 80.0
 
 
-def prepare(data: Measurements) -> tuple[Measurements, tuple, str]:
-    """Rows the model can describe, the responses to fit, and a note of what was left out and why."""
+def prepare(data: Measurements, domain: str = "all") -> tuple[Measurements, tuple, str]:
+    """Rows the model can describe, the responses to fit, and a note of what was used, left out and why.
+
+    ``domain`` (:data:`~.measured.DOMAINS`): "all" (every row with a load, braking, dragged and 90 deg included) or
+    "driving" (the classical subset: driving slip 0 <= i < 1 along the heading, |slip angle| <= MAX_SLIP_ANGLE)."""
+    if domain not in DOMAINS:
+        raise WheelsoilInputError(f"--domain {domain!r}: choose one of {list(DOMAINS)}")
     notes = []
-    domain = (data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) <= MAX_SLIP_ANGLE) & (data.load > 0)
+    inside = data.load > 0
+    if domain == "driving":
+        inside &= (data.slip >= 0.0) & (data.slip < 1.0) & (np.abs(data.slip_angle) <= MAX_SLIP_ANGLE)
     measured = np.any([np.isfinite(v) for v in data.responses.values()], axis=0)
-    if (~domain).any():
-        notes.append(f"{int((~domain).sum())} rows outside the model's domain (driving slip 0 <= i < 1, "
-                     f"|slip angle| <= {MAX_SLIP_ANGLE:g} deg, load > 0)")
-    if (domain & ~measured).any():
-        notes.append(f"{int((domain & ~measured).sum())} rows with no measured response (empty or NaN)")
-    keep = domain & measured
+    if (~inside).any():
+        notes.append(f"left out {int((~inside).sum())} rows outside the domain "
+                     + ("(load > 0)" if domain == "all" else
+                        f"'driving' (driving slip 0 <= i < 1, |slip angle| <= {MAX_SLIP_ANGLE:g} deg, load > 0)"))
+    if (inside & ~measured).any():
+        notes.append(f"left out {int((inside & ~measured).sum())} rows with no measured response (empty or NaN)")
+    keep = inside & measured
     if not keep.any():
         raise WheelsoilInputError(
-            f"{data.name}: no row to fit: {int((~domain).sum())} of {len(data)} rows lie outside the model's domain "
-            f"(driving slip 0 <= i < 1: {int(((data.slip >= 0) & (data.slip < 1)).sum())} rows; load > 0: "
-            f"{int((data.load > 0).sum())} rows; |slip angle| <= {MAX_SLIP_ANGLE:g} deg), "
-            f"{int((~measured).sum())} have no measured response")
+            f"{data.name}: no row to fit in the domain {domain!r}: {int((~inside).sum())} of {len(data)} rows lie "
+            f"outside it (load > 0: {int((data.load > 0).sum())} rows; driving slip 0 <= i < 1: "
+            f"{int(((data.slip >= 0) & (data.slip < 1)).sum())}; |slip angle| <= {MAX_SLIP_ANGLE:g} deg: "
+            f"{int((np.abs(data.slip_angle) <= MAX_SLIP_ANGLE).sum())}), {int((~measured).sum())} have no measured "
+            "response")
     data = data.select(keep)
+    notes.insert(0, f"used {row_counts(data)}")
     responses = [q for q in RESPONSES if np.isfinite(data.responses[q]).any()]
     if data.sinkage_relative and "sinkage" in responses:
         responses.remove("sinkage")
-        notes.append("sinkage (its zero is the wheel's start position, not the soil surface)")
+        notes.append("sinkage not fitted (its zero is the wheel's start position, not the soil surface)")
     return data, tuple(responses), "; ".join(notes)
 
 
@@ -70,8 +81,8 @@ def select_group(data: Measurements, group: str | None) -> Measurements:
     return data
 
 
-def _load_prepared(data_arg: str, group: str | None) -> tuple[Measurements, tuple, str]:
-    return prepare(select_group(load_measurements(data_arg), group))
+def _load_prepared(data_arg: str, group: str | None, domain: str = "all") -> tuple[Measurements, tuple, str]:
+    return prepare(select_group(load_measurements(data_arg), group), domain)
 
 
 def test_errors(d, test: Measurements, *, seed: int = 0, bootstrap: int = 400) -> dict:
@@ -93,16 +104,19 @@ def test_errors(d, test: Measurements, *, seed: int = 0, bootstrap: int = 400) -
 
 def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
              seed: int = 0, group: str | None = None, command: str = "", test: str | None = None,
-             shear_form: str = "independent") -> dict:
+             shear_form: str = "independent", domain: str = "all") -> dict:
     """Load (or synthesise) the data, run discovery, write the report and ``model.json``; with ``test``, also
     predict that second dataset with the model fitted on the first. ``shear_form``: the model's shear form
-    (:class:`~.terramechanics.SoilParameters`; "resultant" is the CMU lab's). Returns the findings dict."""
+    (:class:`~.terramechanics.SoilParameters`; "resultant" is the CMU lab's); ``domain``: the rows to use
+    (:func:`prepare`). Returns the findings dict."""
+    if domain not in DOMAINS:
+        raise WheelsoilInputError(f"--domain {domain!r}: choose one of {list(DOMAINS)}")
     start = SoilParameters(shear_form=shear_form)  # refuses an unknown form before any work
     test_data = None
     if test is not None:  # read and check before any fitting
         if test in ("synthetic", "synthetic-periodic"):
             raise WheelsoilInputError(f"--test {test!r}: give a measured dataset (file or folder)")
-        test_data, _, _ = _load_prepared(test, group)
+        test_data, _, _ = _load_prepared(test, group, domain)
     if data_arg == "synthetic":
         rng = np.random.default_rng(seed)
         if hidden is None:
@@ -118,16 +132,16 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
         save_measurements(data, report / "synthetic_data.csv")
         title = "Validation on synthetic data (the hidden mechanism is revealed at the end)"
         data = select_group(data, group)
-        data, default_responses, excluded = prepare(data)
+        data, default_responses, excluded = prepare(data, domain)
     else:
         if hidden is not None:
             raise WheelsoilInputError("--hidden applies to 'synthetic' data only")
-        data, default_responses, excluded = _load_prepared(data_arg, group)
+        data, default_responses, excluded = _load_prepared(data_arg, group, domain)
         title = f"Validation against {data.name}"
         name = params = None
     mask = parse_holdout(holdout, data, seed)
     d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed, start=start)
-    extra = {"shear_form": shear_form}
+    extra = {"shear_form": shear_form, "domain": domain}
     if test_data is not None:
         extra["test"] = test_errors(d, test_data, seed=seed)
     md, _, findings = write_report(d, data, mask, report, title=title, command=command, excluded=excluded, extra=extra)
@@ -143,14 +157,16 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
 
 
 def cross_validate_command(data_arg: str, by: str, *, report: Path, responses=None, group: str | None = None,
-                           seed: int = 0, command: str = "", progress=None, shear_form: str = "independent") -> dict:
+                           seed: int = 0, command: str = "", progress=None, shear_form: str = "independent",
+                           domain: str = "all") -> dict:
     """``wheelsoil validate DATA --cv CONDITION``: leave each level of CONDITION out in turn (:mod:`.crossval`)."""
     start = SoilParameters(shear_form=shear_form)
-    data, default_responses, _ = _load_prepared(data_arg, group)
+    data, default_responses, _ = _load_prepared(data_arg, group, domain)
     levels(data, by)  # refuse a bad condition before any fitting
     cv = cross_validate(data, by, responses=responses or default_responses, seed=seed, progress=progress,
                         start=start)
     cv["shear_form"] = shear_form
+    cv["domain"] = domain
     cv["report"] = str(write_cross_validation(cv, data, report, command=command))
     return cv
 
@@ -206,12 +222,13 @@ def main_validate(args) -> int:
 
         cv = cross_validate_command(args.data, args.cv, report=args.report, responses=args.responses,
                                     group=args.group, seed=args.seed, command=command, progress=show,
-                                    shear_form=args.shear_form)
+                                    shear_form=args.shear_form, domain=getattr(args, "domain", "all"))
         console.print(f"wrote {cv['report']}")
         return 0
     findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
                         hidden=args.hidden, seed=args.seed, group=args.group, command=command,
-                        test=getattr(args, "test", None), shear_form=getattr(args, "shear_form", "independent"))
+                        test=getattr(args, "test", None), shear_form=getattr(args, "shear_form", "independent"),
+                        domain=getattr(args, "domain", "all"))
     base = findings["baseline"]
     console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out); "
                   f"final model: {findings['final']['heldout_rmse']:.3f} (held out)")
