@@ -44,7 +44,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
 
-    heading = load_cmu_trials(args.data, driving_only=False)
+    heading = load_cmu_trials(args.data)
     # the rig's own slip column, in the loader's row order (grouser file, then smooth)
     travel = np.concatenate([load_table(Path(args.data) / f"{w}_wheel_trials.csv").columns["slip"]
                              for w in ("grouser", "smooth")])
