@@ -367,6 +367,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="rows to use: 'all' (default: braking, dragged and 90 deg rows included; the report counts "
                         "each kind) or 'driving' (the classical subset: driving slip 0 <= i < 1 along the heading, "
                         "|slip angle| <= 80 deg)")
+    p.add_argument("--resume", action="store_true",
+                   help="with --cv: keep each finished fold in REPORT/folds and reuse those of the same data, "
+                        "responses, seed and model on a later run")
     p.set_defaults(func=cmd_validate)
 
     soil_lab_command.add_parser(sub)

@@ -8,6 +8,8 @@ cross-validations)::
     python docs/validation_examples.py
     python docs/validation_examples.py --tables-only   # rewrite README.md (and crossval.md) from the saved JSON
     python docs/validation_examples.py --only cmu-random-holdout cmu-large-steering   # rerun these, keep the rest
+
+The cross-validations resume (``--resume``): their finished folds are kept in ``<example>/folds``.
 """
 
 import json
@@ -21,7 +23,8 @@ MEASURED = Path("..") / "shared" / "data" / "measured"  # relative to the reposi
 #: example -> (DATA, extra arguments, what it asks)
 EXAMPLES = {
     "cmu-large-steering": (str(MEASURED / "cmu_3d_terramechanics"), ["--holdout", "slip_angle=60"],
-                           "calibrated on steering angles up to 45 deg, does the model carry to 60 deg?"),
+                           "calibrated on the other steering angles (0-45, 75 and 90 deg), does the model carry to "
+                           "60 deg?"),
     "cmu-random-holdout": (str(MEASURED / "cmu_3d_terramechanics"), ["--seed", "0"],
                            "both wheels, all angles, a random 30 % held out: what does the model miss?"),
     "digitised-ding2011": (str(MEASURED / "digitised_single_wheel" / "single_wheel_experiments.csv"),
@@ -55,15 +58,16 @@ PERIODIC_EXAMPLES = {
 
 #: The commit from which the CMU loader reads the rig's slip along the heading (docs/validation/slip-convention).
 HEADING_SLIP_COMMIT = "80e220b"
+#: The commit from which the model covers every measured row (braking, dragged, 90 deg) and the loader keeps them.
+WHOLE_DOMAIN_COMMIT = "2b598e7"
 
 
-def _predates_heading_slip(out: Path) -> bool:
-    """Whether the saved run in ``out`` was made before the CMU loader read slip along the heading (its provenance's
-    commit is not a descendant of :data:`HEADING_SLIP_COMMIT`)."""
+def _predates(out: Path, commit: str) -> bool:
+    """Whether the saved run in ``out`` was made before ``commit`` (its provenance's commit is not a descendant)."""
     saved = out / "findings.json" if (out / "findings.json").is_file() else out / "crossval.json"
     rev = json.loads(saved.read_text()).get("provenance", {}).get("git_rev", "")
     rev = rev.split("-")[0].split("+")[0]
-    done = subprocess.run(["git", "merge-base", "--is-ancestor", HEADING_SLIP_COMMIT, rev], capture_output=True)
+    done = subprocess.run(["git", "merge-base", "--is-ancestor", commit, rev], capture_output=True)
     return done.returncode != 0
 
 
@@ -115,7 +119,7 @@ def main(argv=None) -> int:
              "held-out angle |", "|---|---|---|---|---|"]
     for name, (data, what) in CV_EXAMPLES.items():
         out = ROOT / "validation" / name
-        argv = ["validate", data, "--cv", "slip_angle", "--report", str(out.relative_to(ROOT.parent))]
+        argv = ["validate", data, "--cv", "slip_angle", "--report", str(out.relative_to(ROOT.parent)), "--resume"]
         print("wheelsoil", " ".join(argv), flush=True)
         if cli(argv, name) != 0:
             return 1
@@ -146,12 +150,17 @@ def main(argv=None) -> int:
                         f"{m['value']:.4g} ({truth}) | {m['gain']:+.3f} ± {m['gain_se']:.3f} |")
         else:
             rows.append(f"| [{name}]({name}/report.md) | {question} | {law} | nothing | – | – |")
-    stale = [n for n, (data, *_) in {**EXAMPLES, **CV_EXAMPLES}.items()
-             if "cmu_3d_terramechanics" in data and _predates_heading_slip(ROOT / "validation" / n)]
+    cmu = [n for n, (data, *_) in {**EXAMPLES, **CV_EXAMPLES}.items() if "cmu_3d_terramechanics" in data]
+    stale = [n for n in cmu if _predates(ROOT / "validation" / n, HEADING_SLIP_COMMIT)]
     if stale:
         rows[1:1] = ["", f"**Note:** {', '.join(stale)} predate the CMU loader's reading of the rig's slip along the "
                      "heading ([slip-convention](slip-convention/README.md)): they fitted the model at the wrong slips "
                      "above 0 deg and are to be run again (`--only NAME`)."]
+    driving_only = [n for n in cmu if n not in stale and _predates(ROOT / "validation" / n, WHOLE_DOMAIN_COMMIT)]
+    if driving_only:
+        rows[1:1] = ["", f"**Note:** {', '.join(driving_only)} predate the model over the whole measured domain: they "
+                     "used the driving rows below 90 deg only (148 of 297), not the braking, dragged and 90 deg rows, "
+                     "and are to be run again (`--only NAME`)."]
     (ROOT / "validation" / "README.md").write_text("\n".join(rows) + "\n")
     return 0
 

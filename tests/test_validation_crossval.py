@@ -29,3 +29,35 @@ def test_a_hidden_mechanism_carries_to_every_held_out_steering_angle(seed, tmp_p
     md = write_cross_validation(cv, data, tmp_path, command="wheelsoil validate synthetic --cv slip_angle").read_text()
     assert "| held-out slip_angle | rows | found on the rest | unexplained on the rest |" in md
     assert md.count("\n| ") == 1 + len(folds)  # header and one row per fold (the separator starts with "|-")
+
+
+def test_a_cross_validation_resumes_from_its_finished_folds(tmp_path, monkeypatch):
+    """Finished folds are kept and reused; a different seed recomputes them. The workflow is replaced by the
+    classical model at its starting soil (the bookkeeping is under test, not the selection)."""
+    from types import SimpleNamespace
+
+    from wheelsoil.validation import crossval
+    from wheelsoil.validation.terramechanics import SoilParameters
+
+    calls = []
+
+    def classical_only(data, *, responses, heldout, **kw):
+        calls.append(int(heldout.sum()))
+        fit = SimpleNamespace(soil=SoilParameters())
+        return SimpleNamespace(baseline=fit, final=fit, responses=tuple(responses), scales={q: 1.0 for q in responses},
+                               found=[], partial=[], ambiguities=[], unexplained=[])
+
+    monkeypatch.setattr(crossval, "discover", classical_only)
+    rng = np.random.default_rng(7)
+    data = synthetic_measurements({}, rng, cond=conditions(gravities=(9.81,), loads=(60.0,)))
+    run = lambda seed: cross_validate(data, "slip_angle", responses=("drawbar_pull",), seed=seed,  # noqa: E731
+                                      bootstrap=50, resume_dir=tmp_path)
+    first = run(1)
+    assert len(calls) == len(first["folds"]) == len(list(tmp_path.glob("fold-*.json"))) == 4
+    calls.clear()
+    assert run(1) == first and calls == []
+    (tmp_path / "fold-1.json").unlink()  # a fold lost: only it runs again, to the same numbers
+    assert run(1) == first and calls == [5]
+    calls.clear()
+    run(2)
+    assert len(calls) == 4  # another seed matches no saved fold

@@ -4,14 +4,20 @@ Each level of a condition (a steering angle, a load, a gravity level, a wheel) i
 workflow (classical calibration, forward selection) runs on the other levels, and the held-out level is predicted
 by the classical and by the final model. The gain per held-out level shows whether a finding carries beyond the
 conditions it was fitted on, and the mechanisms found per fold whether the finding itself is stable.
+
+Each fold is independent (its bootstrap draws from its own seed, (seed, fold index)), so a cross-validation
+resumes: with ``resume_dir`` every finished fold is written there as it ends and kept by a later run of the same
+data, responses, seed and starting soil (``wheelsoil validate --cv ... --resume``).
 """
 
+import hashlib
+import json
 from pathlib import Path
 
 import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.provenance import provenance, write_markdown_and_json
+from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_json
 
 from .calibration import normalised_residuals
 from .discovery import discover
@@ -31,18 +37,45 @@ def levels(data: Measurements, by: str) -> list:
     return out
 
 
+def _fold_key(data: Measurements, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
+    """What a saved fold must match to be kept: the data (a digest of every condition and response), the held-out
+    level, the responses, the seed, the bootstrap size and the starting soil."""
+    digest = hashlib.sha256()
+    for key in ("slip", "slip_angle", "load", "gravity", "passes", "radius", "width", "grouser_height",
+                "grouser_count", "travel_slip"):
+        digest.update(np.ascontiguousarray(getattr(data, key), float).tobytes())
+    for q in sorted(data.responses):
+        digest.update(q.encode() + np.ascontiguousarray(data.responses[q], float).tobytes())
+    digest.update("|".join(map(str, data.group)).encode())
+    return {"data": digest.hexdigest()[:20], "condition": by, "level": level if isinstance(level, str) else float(level),
+            "responses": list(responses), "seed": seed, "bootstrap": bootstrap,
+            "start": None if start is None else start.to_dict()}
+
+
 def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, bootstrap: int = 400,
-                   progress=None, start=None) -> dict:
+                   progress=None, start=None, resume_dir: str | Path | None = None) -> dict:
     """Hold out each level of ``by`` in turn (see the module docstring). Returns a dict with one fold per level:
     the mechanisms found, the classical and final model's normalised RMSE on the held-out level, the gain and its
     bootstrap standard deviation. ``start``: the soil every fold starts from (:func:`.discovery.discover`), e.g.
     with the lab's ``shear_form``. A mechanism accepted on the rest but not named (``partial``: the model still
-    leaves a systematic residual where it acts) is in the final model, so it can carry a gain."""
+    leaves a systematic residual where it acts) is in the final model, so it can carry a gain. ``resume_dir``: keep
+    finished folds there and reuse those that match (module docstring)."""
     values = np.asarray(getattr(data, by))
     folds = []
-    rng = np.random.default_rng(seed)
-    for level in levels(data, by):
+    for k, level in enumerate(levels(data, by)):
         mask = values == level
+        saved = None
+        if resume_dir is not None:
+            key = _fold_key(data, by, level, responses, seed, bootstrap, start)
+            saved = Path(resume_dir) / f"fold-{k}.json"
+            if saved.is_file():
+                kept = json.loads(saved.read_text())
+                if kept.get("key") == key:
+                    folds.append(kept["fold"])
+                    if progress:
+                        progress(folds[-1])
+                    continue
+        rng = np.random.default_rng([seed, k])
         d = discover(data, responses=responses, heldout=mask, seed=seed, bootstrap=bootstrap, start=start)
         test = data.select(mask)
         base = normalised_residuals(d.baseline.soil, test, d.responses, d.scales)
@@ -55,6 +88,10 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
                       "ambiguities": d.ambiguities,
                       "unexplained": [u["text"] for u in d.unexplained], "classical_nrmse": b, "final_nrmse": f,
                       "gain": b - f, "gain_std": float(np.std(diffs))})
+        if saved is not None:
+            saved.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_output(saved) as tmp:
+                tmp.write_text(json.dumps({"key": key, "fold": folds[-1]}, indent=1, default=float))
         if progress:
             progress(folds[-1])
     names = sorted({n for fold in folds for n in fold["found"]})

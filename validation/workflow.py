@@ -158,13 +158,14 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
 
 def cross_validate_command(data_arg: str, by: str, *, report: Path, responses=None, group: str | None = None,
                            seed: int = 0, command: str = "", progress=None, shear_form: str = "independent",
-                           domain: str = "all") -> dict:
-    """``wheelsoil validate DATA --cv CONDITION``: leave each level of CONDITION out in turn (:mod:`.crossval`)."""
+                           domain: str = "all", resume: bool = False) -> dict:
+    """``wheelsoil validate DATA --cv CONDITION``: leave each level of CONDITION out in turn (:mod:`.crossval`);
+    with ``resume``, finished folds are kept in ``report/folds`` and reused by a later run."""
     start = SoilParameters(shear_form=shear_form)
     data, default_responses, _ = _load_prepared(data_arg, group, domain)
     levels(data, by)  # refuse a bad condition before any fitting
     cv = cross_validate(data, by, responses=responses or default_responses, seed=seed, progress=progress,
-                        start=start)
+                        start=start, resume_dir=Path(report) / "folds" if resume else None)
     cv["shear_form"] = shear_form
     cv["domain"] = domain
     cv["report"] = str(write_cross_validation(cv, data, report, command=command))
@@ -222,7 +223,8 @@ def main_validate(args) -> int:
 
         cv = cross_validate_command(args.data, args.cv, report=args.report, responses=args.responses,
                                     group=args.group, seed=args.seed, command=command, progress=show,
-                                    shear_form=args.shear_form, domain=getattr(args, "domain", "all"))
+                                    shear_form=args.shear_form, domain=getattr(args, "domain", "all"),
+                                    resume=getattr(args, "resume", False))
         console.print(f"wrote {cv['report']}")
         return 0
     findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
