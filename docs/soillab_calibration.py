@@ -43,6 +43,11 @@ plate's pressure fell in proportion to the pressing speed; the EPSD law holds su
 repose angle and the plates both depend on the law, so the friction grid is run again, the same nine candidates,
 poured and tested with ``rolling_model = "epsd"`` for every soil contact (particles, box, plates), with the shear box,
 scored by the same objective.
+
+Design "epsd-surface" (2026-11-27, after the EPSD grid): the lab verifies the quadratic response surface's minimum
+before it is adopted. The EPSD grid's surface has its minimum at sliding 0.52, rolling 0.50 (predicted objective
+0.46, against the grid's least, 0.83 at sliding 0.7, rolling 0.5), so that one candidate is run, with the shear box,
+and adopted only if its measured objective is below the grid's least.
 """
 
 from __future__ import annotations
@@ -67,6 +72,7 @@ DESIGNS = {
     "friction": tuple((mu, mu_r, 1.0, False, "cdt") for mu in FRICTIONS for mu_r in ROLLING),
     "packing": ((0.5, 0.5, 0.0, True, "cdt"), (0.5, 0.5, 0.25, True, "cdt"), (0.5, 0.5, 1.0, True, "cdt")),
     "epsd": tuple((mu, mu_r, 1.0, True, "epsd") for mu in FRICTIONS for mu_r in ROLLING),
+    "epsd-surface": ((0.52, 0.5, 1.0, True, "epsd"),),
 }
 
 
