@@ -7,13 +7,19 @@ Usage (from the repository root; 15-60 s a draw on one core, ``--workers`` proce
     python docs/validation_campaign.py single --draws 44 --seed 2 --workers 2   # each catalogue mechanism in turn
     python docs/validation_campaign.py pair   --draws 30 --seed 3 --workers 2   # two mechanisms hidden together
     python docs/validation_campaign.py ooc    --draws 30 --seed 4 --workers 2   # effects outside the catalogue
+    python docs/validation_campaign.py ooc-load --draws 40 --seed 41 --workers 2 --resume  # load and gravity varied
     python docs/validation_campaign.py periodic --draws 40 --seed 7             # periodic mechanisms in series
     python docs/validation_campaign.py summary docs/validation/campaigns/*.jsonl  # the table of rates
 
 Each draw's seed comes from ``numpy.random.SeedSequence(seed).spawn``; its noise is drawn too: a noise level of
 1-5 % of each response's spread plus 0-4 % of its value (heteroscedastic, as repeated rig tests scatter). Every
 draw's outcome is one JSON line (``--out``, default ``docs/validation/campaigns/<kind>-<seed>.jsonl``), written as
-it finishes, so an interrupted campaign keeps what it did.
+it finishes, so an interrupted campaign keeps what it did; ``--resume`` runs only the draws the file lacks.
+
+``ooc-load`` (issue 36) hides every out-of-catalogue effect in turn, those that follow the load among them, in a
+design where the load (40, 80, 160 N) and the gravity (9.81, 1.62 m/s^2) vary independently
+(:func:`wheelsoil.validation.synthetic.load_gravity_conditions`): the load acts through the weight on the wheel as
+gravity does, so an effect that follows the load is the test of rivals along every condition the data vary.
 
 ``periodic`` draws seed 002's density wave, seed 000's spoke-stiffness radius or nothing, hides it in
 drawbar-pull series with red noise (:func:`wheelsoil.validation.synthetic.synthetic_oscillation_series`) and
@@ -30,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-KINDS = ("null", "single", "pair", "ooc")
+KINDS = ("null", "single", "pair", "ooc", "ooc-load")
 
 
 def draw(kind: str, index: int, seed_seq) -> dict:
@@ -47,10 +53,11 @@ def draw(kind: str, index: int, seed_seq) -> dict:
         truth = [names[j] for j in rng.choice(len(names), 2, replace=False)]
     for name in truth:
         hidden.update(syn.draw_hidden_effect(rng, [name])[1])
-    if kind == "ooc":
+    if kind in ("ooc", "ooc-load"):
         effect = syn.draw_out_of_catalogue(rng, [list(syn.OUT_OF_CATALOGUE)[index % len(syn.OUT_OF_CATALOGUE)]])
     noise, relative = float(rng.uniform(0.01, 0.05)), float(rng.uniform(0.0, 0.04))
-    data = syn.synthetic_measurements(hidden, rng, effect=effect, noise=noise, relative_noise=relative)
+    cond = syn.load_gravity_conditions() if kind == "ooc-load" else None
+    data = syn.synthetic_measurements(hidden, rng, effect=effect, noise=noise, relative_noise=relative, cond=cond)
     t0 = time.perf_counter()
     d = discover(data, seed=int(rng.integers(2 ** 31)))
     found = d.found
@@ -69,8 +76,12 @@ def _run(args) -> int:
     out = Path(args.out or f"docs/validation/campaigns/{args.kind}-{args.seed}.jsonl")
     out.parent.mkdir(parents=True, exist_ok=True)
     seqs = np.random.SeedSequence(args.seed).spawn(args.draws)
-    with open(out, "w") as fh, ProcessPoolExecutor(args.workers) as pool:
-        futures = [pool.submit(draw, args.kind, k, s) for k, s in enumerate(seqs)]
+    done = set()
+    if args.resume and out.is_file():
+        done = {json.loads(line)["index"] for line in out.read_text().splitlines() if line.strip()}
+        print(f"{out}: {len(done)} draw(s) done before, kept", flush=True)
+    with open(out, "a" if args.resume else "w") as fh, ProcessPoolExecutor(args.workers) as pool:
+        futures = [pool.submit(draw, args.kind, k, s) for k, s in enumerate(seqs) if k not in done]
         for f in futures:
             r = f.result()
             fh.write(json.dumps(r) + "\n")
@@ -87,7 +98,8 @@ def summarise(paths) -> str:
     rows = ["| campaign | draws | truth named (all of it) | a wrong name | partial (accepted, not named) | ambiguity | "
             "unexplained reported | goal |", "|---|---|---|---|---|---|---|---|"]
     goals = {"null": "≤ 5 % name any mechanism", "single": "named in ≥ 95 %",
-             "pair": "both named in ≥ 80 %, a wrong name in ≤ 5 %", "ooc": "a wrong name in ≤ 5 %, unexplained in most"}
+             "pair": "both named in ≥ 80 %, a wrong name in ≤ 5 %", "ooc": "a wrong name in ≤ 5 %, unexplained in most",
+             "ooc-load": "a wrong name in ≤ 5 %, unexplained in most"}
     details = []
     for path in paths:
         recs = [json.loads(line) for line in open(path)]
@@ -103,7 +115,7 @@ def summarise(paths) -> str:
                    else "not recorded")
         rows.append(f"| `{Path(path).name}` | {n} | {pct(named) if kind in ('single', 'pair') else '–'} | {pct(wrong)} | "
                     f"{partial} | {pct(amb)} | {pct(unexpl)} | {goals.get(kind, '')} |")
-        if kind in ("single", "ooc"):
+        if kind in ("single", "ooc", "ooc-load"):
             key = (lambda r: r["truth"][0]) if kind == "single" else (lambda r: r["effect"][0])
             details += ["", f"`{Path(path).name}` by hidden {'mechanism' if kind == 'single' else 'effect'}:", "",
                         "| hidden | draws | named | wrong name | partial | ambiguity | unexplained |",
@@ -136,6 +148,7 @@ def main(argv=None) -> int:
     ap.add_argument("--draws", type=int, default=16)
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--resume", action="store_true", help="keep the draws the output file holds; run the rest")
     ap.add_argument("--noise", type=float, default=0.03,
                     help="periodic: red-noise standard deviation / median steady drawbar pull (default 0.03)")
     args = ap.parse_args(argv)

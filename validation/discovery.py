@@ -31,8 +31,9 @@ Two candidates that both pass and whose BICs are within :data:`AMBIGUITY_MARGIN`
 equally well: the model with both is fitted, and if the second adds nothing beyond the first (BIC not lower by
 :data:`BIC_MARGIN`, or its parameter at a bound) the step reports an **ambiguity** between them and selection stops
 there, instead of picking one. The best passing mechanism must also beat its **generic rivals**
-(:func:`_drift_rivals`): each classical parameter drifting linearly with a condition the mechanism acts through
-(:func:`~.extensions.drift_rivals`), fitted in its place. A rival whose BIC is lower by more than
+(:func:`_drift_rivals`): each classical parameter drifting linearly with each condition the data vary (slip, slip
+angle, gravity, pass, load, wheel radius and width; :func:`~.extensions.drift_rivals`), fitted in its place, so an
+effect that follows a condition the mechanism does not act through (the load) is not read as the mechanism. A rival whose BIC is lower by more than
 :data:`RIVAL_MARGIN` explains the residual better with a form outside the catalogue ("some soil property changes
 with slip"): the mechanism is not named, the step reports an ambiguity between it and the rival, and selection
 stops. A weak effect of an unknown form otherwise takes the name of the nearest catalogue mechanism
@@ -59,7 +60,8 @@ from .calibration import (
     normalised_residuals,
     response_scales,
 )
-from .extensions import BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, drift_rival, drift_rivals
+from .extensions import (BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, drift_reference, drift_rival, drift_rivals,
+                         varied_conditions)
 from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
 from .terramechanics import SoilParameters
@@ -78,7 +80,7 @@ GAIN_SIGMAS = 1.0
 #: look-ahead of one step).
 PAIR_POOL = 6
 AMBIGUITY_MARGIN = 10.0
-#: A generic rival (a classical parameter drifting with a condition the mechanism acts through) withholds the
+#: A generic rival (a classical parameter drifting with a condition the data vary) withholds the
 #: mechanism's name when the data prefer it: its BIC lower than the mechanism's by more than this, the smallest
 #: difference Kass & Raftery (1995) grade as evidence ("positive"; below 2 "not worth more than a bare mention").
 #: Not :data:`AMBIGUITY_MARGIN`, which is for two mechanisms of equal standing: a drift names no physics, so a tie
@@ -351,17 +353,19 @@ def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[
 
 
 def _drift_rivals(train, current: Fit, free, best: Candidate, responses, scales) -> list[dict]:
-    """Each generic drift that rivals a member of ``best`` (:func:`~.extensions.drift_rivals`), fitted in that
-    member's place on the current model (every other parameter free again): its BIC against the current model and
-    against ``best``. A rival lower by more than :data:`RIVAL_MARGIN` explains the residual better with a form
-    outside the catalogue: the data do not single out the mechanism."""
+    """Each generic drift that rivals a member of ``best`` (:func:`~.extensions.drift_rivals`, along every condition
+    the training rows vary), fitted in that member's place on the current model (every other parameter free again):
+    its BIC against the current model and against ``best``. A rival lower by more than :data:`RIVAL_MARGIN`
+    explains the residual better with a form outside the catalogue: the data do not single out the mechanism."""
     out = []
+    varied = varied_conditions(train)
     for member in best.extensions:
         others = tuple(e for e in best.extensions if e is not member)
         base = current.soil if not others else replace(best.fit.soil, **member.off)
-        for field_, condition in drift_rivals(member):
+        for field_, condition in drift_rivals(member, varied):
             rival = drift_rival(field_, condition)
-            start = replace(base, drift_field=field_, drift_condition=condition, drift_rate=0.0)
+            start = replace(base, drift_field=field_, drift_condition=condition, drift_rate=0.0,
+                            drift_reference=drift_reference(train, condition))
             fit = calibrate(train, start, free + tuple(p for e in others for p in e.parameters) + rival.parameters,
                             responses=responses, scales=scales)
             out.append({"name": rival.name, "description": rival.mechanism, "replaces": member.name,

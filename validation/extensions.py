@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from .terramechanics import DRIFT_FIELDS
+from .terramechanics import DRIFT_FIELDS, DRIFT_MEASURES, RELATIVE_DRIFTS
 
 
 @dataclass(frozen=True)
@@ -209,9 +209,8 @@ DRIFT_RATE = Parameter("drift_rate", -1.5, 1.5)
 
 def drift_rival(field: str, condition: str) -> Extension:
     """A generic rival, not a mechanism: the classical parameter ``field`` varying linearly with ``condition``
-    (:data:`~.terramechanics.DRIFT_MEASURES`). Fitted in place of a mechanism that acts through ``condition``: if
-    it explains the residual better (:data:`~.discovery.RIVAL_MARGIN`), the data prefer another form to the
-    mechanism's."""
+    (:data:`~.terramechanics.DRIFT_MEASURES`). Fitted in place of a mechanism: if it explains the residual better
+    (:data:`~.discovery.RIVAL_MARGIN`), the data prefer another form to the mechanism's."""
     return Extension(f"{field} ~ {condition}",
                      f"{field.replace('_x', '').replace('_', ' ')} varying linearly with "
                      f"{condition.replace('_', ' ')} (a generic form outside the catalogue)",
@@ -219,7 +218,28 @@ def drift_rival(field: str, condition: str) -> Extension:
                      lambda d: True)
 
 
-def drift_rivals(ext: Extension) -> list[tuple[str, str]]:
-    """The (field, condition) drifts that rival ``ext``: every classical field drifting with each condition the
-    mechanism acts through, except the drifts that are catalogue mechanisms."""
-    return [(f, c) for c in ext.acts_through for f in DRIFT_FIELDS if (f, c) not in CATALOGUE_DRIFTS]
+def varied_conditions(data) -> tuple[str, ...]:
+    """The conditions of :data:`~.terramechanics.DRIFT_MEASURES` whose measure varies over ``data``'s rows (a drift
+    along a constant condition is the classical parameter again)."""
+    values = {"slip": np.abs(data.slip), "slip_angle": np.abs(np.sin(np.radians(data.slip_angle))),
+              "gravity": data.gravity, "passes": data.passes, "load": data.load, "radius": data.radius,
+              "width": data.width}
+    return tuple(c for c in DRIFT_MEASURES if np.ptp(np.asarray(values[c], float)) > 0.0)
+
+
+def drift_reference(data, condition: str) -> float:
+    """x_ref of a drift along ``condition`` over ``data`` (the median of the rows; 1 for the conditions whose
+    measure needs none)."""
+    if condition not in RELATIVE_DRIFTS:
+        return 1.0
+    return float(np.median(np.asarray(getattr(data, condition), float)))
+
+
+def drift_rivals(ext: Extension, conditions=None) -> list[tuple[str, str]]:
+    """The (field, condition) drifts that rival ``ext``: every classical field drifting with each of
+    ``conditions`` (those the data vary, :func:`varied_conditions`; by default the ones the mechanism acts
+    through), except the drifts that are catalogue mechanisms. A mechanism is named only when it beats the drifts
+    along every condition the data vary, not only those it acts through: an effect that follows the load must not
+    be read as the nearest mechanism that acts through gravity."""
+    conditions = ext.acts_through if conditions is None else conditions
+    return [(f, c) for c in conditions for f in DRIFT_FIELDS if (f, c) not in CATALOGUE_DRIFTS]

@@ -241,7 +241,7 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
               "the systematic residual. When no single mechanism passes and a systematic residual remains, the "
               f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
               f"needs each member to lower BIC by {BIC_MARGIN:g} beyond the other alone. The best passing mechanism "
-              "is named only if no generic drift of a classical parameter with a condition it acts through fits "
+              "is named only if no generic drift of a classical parameter with a condition the data vary fits "
               f"better in its place (BIC lower by more than {RIVAL_MARGIN:g}).", ""]
     for s in findings["steps"]:
         kind = " (pairs, look-ahead)" if s.get("pairs") else ""
@@ -256,7 +256,7 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
         lines.append("")
         if s.get("rivals"):
             lines += [("Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
-                       f"it acts through, fitted in its place; one lower than the mechanism by more than {RIVAL_MARGIN:g} "
+                       f"the data vary, fitted in its place; one lower than the mechanism by more than {RIVAL_MARGIN:g} "
                        "in the last column, and the mechanism is not named):"), "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
                       "|---|---|---|---|---|"]
             lines += [f"| {r['description']} | {r['replaces']} | {r['rate']:+.3g} | {r['delta_bic']:+.1f} | "

@@ -83,7 +83,34 @@ OUT_OF_CATALOGUE = {
         "field": "friction_angle", "range": (6.0, 12.0),
         "law": lambda v, d, c: v - d * (np.abs(c["slip"]) / 0.7) * (
             np.sin(np.radians(np.abs(c["slip_angle"]))) / np.sin(np.radians(30.0)))},
+    # effects that follow the load, which acts through the weight on the wheel as gravity does (issue 36: with
+    # rivals only along the conditions a mechanism acts through, such an effect was read as a gravity mechanism)
+    "friction_load": {
+        "description": "friction angle falling as the load grows, phi - d ln(W / 90 N) (a stress-dependent friction "
+                       "angle, as a sand's curved Mohr envelope)",
+        "field": "friction_angle", "range": (3.0, 6.0),
+        "law": lambda v, d, c: v - d * np.log(c["load"] / 90.0)},
+    "cohesion_load": {
+        "description": "cohesion growing with the load, c (W / 90 N)^m (an apparent cohesion of a soil packed "
+                       "under the wheel)",
+        "field": "cohesion", "range": (0.6, 1.0),
+        "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
+    "kphi_load": {
+        "description": "frictional pressure modulus growing with the load, k'_phi (W / 90 N)^m (a soil stiffened "
+                       "by its own compaction; the load, not the gravity, sets it)",
+        "field": "kphi_prime", "range": (0.4, 0.8),
+        "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
 }
+#: The out-of-catalogue effects that follow the load (:data:`OUT_OF_CATALOGUE`).
+LOAD_EFFECTS = ("shear_modulus_load", "density_load", "friction_load", "cohesion_load", "kphi_load")
+
+
+def load_gravity_conditions():
+    """A design with the load and the gravity varied independently over a wider load range than
+    :func:`conditions`: loads 40, 80 and 160 N (a factor of four) at 9.81 and 1.62 m/s^2 (Earth and Moon), each
+    load at each gravity, the same slips and slip angles, the pass number balanced (issue 36's out-of-catalogue
+    campaign)."""
+    return conditions(loads=(40.0, 80.0, 160.0), gravities=(EARTH_GRAVITY, 1.62))
 
 
 def conditions(slips=(0.05, 0.2, 0.35, 0.5, 0.7), slip_angles=(0.0, 10.0, 20.0, 30.0),

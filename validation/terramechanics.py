@@ -43,9 +43,9 @@ Equations (seed 003 = Zhou et al., Artemis; seed 000 = Ding et al. / Kovecses et
 
 A *drift* (``drift_field``, ``drift_condition``, ``drift_rate``) is not a mechanism: it lets one classical soil
 parameter p vary linearly with one test condition, p (1 + rate u), u the condition's own measure
-(:data:`DRIFT_MEASURES`). The discovery workflow fits drifts as generic rivals of a mechanism that acts through
-the same condition (:mod:`wheelsoil.validation.discovery`): a mechanism is named only when the data single out
-its form, not merely "some soil property changes with slip".
+(:data:`DRIFT_MEASURES`). The discovery workflow fits drifts along every condition the data vary as generic rivals
+of a mechanism (:mod:`wheelsoil.validation.discovery`): a mechanism is named only when the data single out its
+form, not merely "some soil property changes with slip", or with the load.
 """
 
 from dataclasses import asdict, dataclass
@@ -73,13 +73,26 @@ SHEAR_FORMS = ("independent", "resultant")
 #: keep the soil's own value.
 DRIFT_FIELDS = ("cohesion", "friction_angle", "shear_modulus_x", "kc_prime", "kphi_prime", "n0", "a1")
 #: The measure u of each condition a drift is linear in, u = 0 at the reference state: |slip|, sin|slip angle|,
-#: the fall in gravity 1 - g / 9.81, and the earlier passes n_p - 1.
+#: the fall in gravity 1 - g / 9.81, the earlier passes n_p - 1, and for the load and the wheel's radius and width
+#: the relative change x / x_ref - 1 from the reference ``SoilParameters.drift_reference`` (the discovery workflow
+#: takes the training rows' median). Each reads a dict of the conditions (:func:`drift_conditions`).
 DRIFT_MEASURES = {
-    "slip": lambda i, beta, g, n_p: np.abs(i),
-    "slip_angle": lambda i, beta, g, n_p: np.abs(np.sin(beta)),
-    "gravity": lambda i, beta, g, n_p: 1.0 - g / EARTH_GRAVITY,
-    "passes": lambda i, beta, g, n_p: n_p - 1.0,
+    "slip": lambda c: np.abs(c["slip"]),
+    "slip_angle": lambda c: np.abs(np.sin(c["beta"])),
+    "gravity": lambda c: 1.0 - c["gravity"] / EARTH_GRAVITY,
+    "passes": lambda c: c["passes"] - 1.0,
+    "load": lambda c: c["load"] / c["reference"] - 1.0,
+    "radius": lambda c: c["radius"] / c["reference"] - 1.0,
+    "width": lambda c: c["width"] / c["reference"] - 1.0,
 }
+#: The conditions whose drift is measured from a reference value (:data:`DRIFT_MEASURES`).
+RELATIVE_DRIFTS = ("load", "radius", "width")
+
+
+def drift_conditions(slip, beta, gravity, passes, load, radius, width, reference=1.0) -> dict:
+    """The conditions a drift measure reads (arrays or scalars; beta [rad], load [N], radius and width [m])."""
+    return {"slip": slip, "beta": beta, "gravity": gravity, "passes": passes, "load": load, "radius": radius,
+            "width": width, "reference": reference}
 #: A drifted parameter is held at this fraction of its value or more (1 + rate u >= DRIFT_FLOOR).
 DRIFT_FLOOR = 0.05
 
@@ -163,6 +176,8 @@ class SoilParameters:
     drift_field: str = ""
     drift_condition: str = ""
     drift_rate: float = 0.0
+    #: x_ref of a drift along a condition of :data:`RELATIVE_DRIFTS` [N or m]; unused by the others
+    drift_reference: float = 1.0
 
     def __post_init__(self) -> None:
         for key in ("density", "kphi_prime", "n0", "shear_modulus_x", "shear_modulus_y"):
@@ -196,17 +211,18 @@ class SoilParameters:
                 f"drift_condition = {self.drift_condition!r}: allowed {list(DRIFT_MEASURES)} or ''")
         if not np.isfinite(self.drift_rate) or (self.drift_rate and not (self.drift_field and self.drift_condition)):
             raise WheelsoilInputError(f"drift_rate = {self.drift_rate!r} needs a drift_field and a drift_condition")
+        _positive("drift_reference", self.drift_reference)
 
     def to_dict(self) -> dict:
         return asdict(self)
 
-    def drifted(self, name: str, i, beta, g, n_p):
-        """The value of field ``name`` per condition (slip i, slip angle beta [rad], gravity g, pass n_p): the
-        soil's own unless the drift acts on it, then p max(1 + rate u, :data:`DRIFT_FLOOR`)."""
+    def drifted(self, name: str, conditions: dict):
+        """The value of field ``name`` per condition (:func:`drift_conditions`, without the reference): the soil's own
+        unless the drift acts on it, then p max(1 + rate u, :data:`DRIFT_FLOOR`)."""
         value = getattr(self, name)
         if name != self.drift_field or not self.drift_rate:
             return value
-        u = DRIFT_MEASURES[self.drift_condition](i, beta, g, n_p)
+        u = DRIFT_MEASURES[self.drift_condition]({**conditions, "reference": self.drift_reference})
         return value * np.maximum(1.0 + self.drift_rate * u, DRIFT_FLOOR)
 
 
@@ -281,7 +297,7 @@ def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
 
 
 def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity,
-                   extra_pressure=0.0, passes=1.0, vertical_only: bool = False, travel_slip=None) -> dict:
+                   extra_pressure=0.0, passes=1.0, vertical_only: bool = False, travel_slip=None, load=np.nan) -> dict:
     """Soil forces on the wheel at a given sinkage (arrays broadcast together; ``slip_angle`` in degrees).
 
     ``slip`` is along the heading (it sets theta_m, the sinkage exponent and slip drifts); the shear displacements
@@ -291,19 +307,24 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
 
     ``extra_pressure`` [Pa] is added to the normal stress over the whole contact, as seed 002 eq. 17 adds its
     oscillating term A_gamma sin(omega t + Phi) (:mod:`wheelsoil.validation.oscillation`); 0 by default.
-    ``passes`` is the wheel's pass number n_p over the same soil (1: undisturbed; see ``multipass_k2``).
+    ``passes`` is the wheel's pass number n_p over the same soil (1: undisturbed; see ``multipass_k2``). ``load``
+    [N] is read only by a drift along the load (:data:`DRIFT_MEASURES`; :func:`predict` passes it).
 
     Returns a dict of 1-D arrays: drawbar_pull, lateral_force, vertical_force, torque [N, N m] and the
     contact angles theta_f, theta_m, theta_r [rad]; with ``vertical_only`` just vertical_force (what the
     sinkage solve of :func:`predict` needs, about a third cheaper).
     """
-    z, i, beta_deg, g, p_extra, n_p, s_travel = (a.ravel() for a in np.broadcast_arrays(*(np.asarray(v, float) for v in (
-        sinkage, slip, slip_angle, gravity, extra_pressure, passes, np.nan if travel_slip is None else travel_slip))))
+    z, i, beta_deg, g, p_extra, n_p, s_travel, w_load = (a.ravel() for a in np.broadcast_arrays(*(
+        np.asarray(v, float) for v in (sinkage, slip, slip_angle, gravity, extra_pressure, passes,
+                                       np.nan if travel_slip is None else travel_slip, load))))
     beta = np.radians(beta_deg)
     speeds = _wheel_speeds(i, beta_deg, s_travel)
     i = np.where(np.isfinite(s_travel), speeds.heading_slip, i)  # the heading slip the speeds give
     r, b = effective_radius(soil, wheel), wheel.width
-    drifted = lambda name: soil.drifted(name, i, beta, g, n_p)  # noqa: E731  (the soil's own unless drifting)
+    if soil.drift_rate and soil.drift_condition == "load" and not np.isfinite(w_load).all():
+        raise WheelsoilInputError("a drift along the load needs the load of every condition (contact_forces load=)")
+    at = drift_conditions(i, beta, g, n_p, w_load, wheel.radius, wheel.width)
+    drifted = lambda name: soil.drifted(name, at)  # noqa: E731  (the soil's own unless drifting)
     phi = np.radians(drifted("friction_angle"))
     compaction = 1.0 + soil.multipass_k2 * (n_p - 1.0)  # seed 003 eq. 23 with k1 = 1 - k2
     density = soil.density * compaction
@@ -492,7 +513,7 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
 
     def excess(z):
         return contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, vertical_only=True,
-                              travel_slip=s_travel)["vertical_force"] - load
+                              travel_slip=s_travel, load=load)["vertical_force"] - load
 
     lo, f_lo = np.zeros_like(load), -load.copy()
     hi = np.full_like(load, max_sinkage_ratio * wheel.radius)
@@ -520,7 +541,7 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
     else:
         raise RuntimeError(f"sinkage did not converge in {max_iterations} iterations")
     z = np.where(supported, z, max_sinkage_ratio * wheel.radius)
-    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel)
+    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel, load=load)
     out["sinkage"] = z
     out["supported"] = supported
     return {k: np.reshape(v, shape) for k, v in out.items()}
