@@ -58,6 +58,7 @@ from wheelsoil.gravity import EARTH_GRAVITY
 from wheelsoil.slip import WheelSpeeds
 
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
+from .shear import janosi_hanamoto, resultant_shear, shear_displacements, wheel_speeds
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
 
 __all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
@@ -318,7 +319,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         np.asarray(v, float) for v in (sinkage, slip, slip_angle, gravity, extra_pressure, passes,
                                        np.nan if travel_slip is None else travel_slip, load))))
     beta = np.radians(beta_deg)
-    speeds = _wheel_speeds(i, beta_deg, s_travel)
+    speeds = wheel_speeds(i, beta_deg, s_travel)
     i = np.where(np.isfinite(s_travel), speeds.heading_slip, i)  # the heading slip the speeds give
     r, b = effective_radius(soil, wheel), wheel.width
     if soil.drift_rate and soil.drift_condition == "load" and not np.isfinite(w_load).all():
@@ -351,22 +352,14 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     sigma = k_pressure[:, None] * np.clip(np.cos(stress_angle) - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
     sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
-    tf = theta_f[:, None]
-    rim, along, across = speeds.rim[:, None], speeds.along[:, None], np.abs(speeds.across)[:, None]
     # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
     eta = np.clip(soil.soil_flow + soil.soil_flow_gravity * (1.0 - g / EARTH_GRAVITY), 0.0, 0.95)
-    # seed 003 eqs. 11 and 14 in velocity components, j = int_theta^theta_f (slip velocity) d theta' / omega: with
-    # v_x = (1 - i) r omega (driving) or r omega / (1 + i) (braking) these are eqs. 12 and 16 on both branches
-    jx = r * _per_rim((tf - theta) * (1.0 - eta[:, None]) * rim - along * (np.sin(tf) - np.sin(theta)), rim)
+    jx, jy = shear_displacements(r, theta_f, theta, speeds, eta)
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
     k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
-
-    def lateral_displacement():  # seed 003 eq. 14: j_y = (theta_f - theta) |v_y| / omega, eq. 16 where tan beta is finite
-        return r * _per_rim((tf - theta) * across, rim)
-
     resultant = soil.shear_form == "resultant"
     if resultant:
-        tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(), k_x, speeds, eta, theta)
+        tau_x, tau_y = resultant_shear(strength, jx, jy, k_x, speeds, eta, theta)
     else:
         tau_x = janosi_hanamoto(strength, jx, k_x)
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
@@ -378,7 +371,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         return {"vertical_force": fz}
     if not resultant:  # the lateral shear is not needed for the sinkage solve
         shear_modulus_y = np.broadcast_to(shear_modulus_y, i.shape)[:, None]
-        tau_y = janosi_hanamoto(strength, lateral_displacement(), shear_modulus_y)
+        tau_y = janosi_hanamoto(strength, jy, shear_modulus_y)
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
@@ -402,51 +395,6 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         "theta_m": theta_m,
         "theta_r": theta_r,
     }
-
-
-def _wheel_speeds(slip, slip_angle_deg, travel_slip) -> WheelSpeeds:
-    """The wheel's speeds from the travel slip in rows where it is finite, else from the heading slip."""
-    given = np.isfinite(travel_slip)
-    if given.all():
-        return WheelSpeeds.from_travel_slip(travel_slip, slip_angle_deg)
-    heading = WheelSpeeds.from_heading_slip(np.where(given, 0.0, slip), np.where(given, 0.0, slip_angle_deg))
-    if not given.any():
-        return heading
-    travel = WheelSpeeds.from_travel_slip(np.where(given, travel_slip, 0.0), slip_angle_deg)
-    return WheelSpeeds(*(np.where(given, getattr(travel, k), getattr(heading, k)) for k in ("rim", "along", "across")))
-
-
-def _per_rim(displacement_rate, rim):
-    """displacement_rate / rim, the integral over the contact of a slip velocity divided by omega [-]: a wheel
-    that does not turn (rim = 0) slides without end, +-inf, the limit of a vanishing rim speed, so the shear it
-    meets is fully mobilised; 0 where nothing slides (a component with no sliding speed: along the heading of a
-    wheel dragged sideways at 90 deg). The independent shear form is discontinuous there (an arbitrarily slow
-    tangential slide at 89.99 deg already mobilises the full strength along x); the resultant form, which shares
-    one strength along the slip velocity, is not."""
-    rim = np.broadcast_to(rim, np.shape(displacement_rate))
-    turning = rim > 0.0
-    sliding = np.where(displacement_rate == 0.0, 0.0, np.copysign(np.inf, displacement_rate))
-    return np.where(turning, displacement_rate / np.where(turning, rim, 1.0), sliding)
-
-
-def janosi_hanamoto(strength, displacement, modulus):
-    """Janosi--Hanamoto shear (seed 003 eqs. 9 and 13) with the sign of the displacement: tau = (c + sigma tan phi)
-    sign(j) (1 - exp(-|j| / k)) [Pa], so |tau| never exceeds the Mohr--Coulomb strength (seed 003 eq. 10) where the
-    soil is sheared backwards (braking, Wong & Reece 1967b) and a sliding wheel's infinite j gives the full
-    strength."""
-    return strength * np.sign(displacement) * -np.expm1(-np.abs(displacement) / modulus)
-
-
-def resultant_shear(strength, jx, jy, k_x, speeds: WheelSpeeds, soil_flow, theta):
-    """The CMU lab's shear (``tau_t.m``, ``tau_l.m``; module docstring): strength [Pa] mobilised by sqrt(j_x^2 +
-    j_y^2) / k_x [m / m] along the slip velocity. Rows: conditions (the wheel's speeds, soil flow eta); columns:
-    theta [rad]. Returns (tau_x, tau_y) [Pa], tau_y a magnitude (its sign is -sign(beta))."""
-    # the slip velocity under the rim (v_jt.m, with the soil's own flow), in the speeds' units
-    v_t = (speeds.rim * (1.0 - soil_flow))[:, None] - speeds.along[:, None] * np.cos(theta)
-    v_l = np.broadcast_to(np.abs(speeds.across)[:, None], v_t.shape)
-    speed = np.hypot(v_t, v_l)
-    mobilised = strength * -np.expm1(-np.hypot(jx, jy) / k_x) / np.where(speed > 0.0, speed, 1.0)
-    return mobilised * v_t, mobilised * v_l
 
 
 def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None,
