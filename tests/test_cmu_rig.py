@@ -112,3 +112,18 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
     data = load_cmu_trials(folder)
     pairs, unmatched = match_conditions(data, simulated)
     assert len(data) == 297 and unmatched.size == 0 and len(pairs) == 297
+
+
+@pytest.mark.parametrize("preset", ["cmu-grouser", "cmu-smooth"])
+def test_the_rig_runs_on_the_calibrated_sand(preset):
+    """The CMU presets hold wheelsoil.parameters.cmu_sand's particles at the wheels' scale, so the twin and the soil
+    lab's calibration cannot drift apart."""
+    from wheelsoil.parameters import cmu_sand
+
+    soil = load_case(preset).soil
+    pair, material = cmu_sand.PARTICLE_PAIR, cmu_sand.PARTICLE_MATERIAL
+    assert (soil.static_friction, soil.rolling_friction, soil.rolling_model, soil.restitution) == (
+        pair.static_friction, pair.rolling_friction, pair.rolling_model, pair.restitution)
+    assert (soil.density, soil.youngs_modulus, soil.poisson_ratio) == (
+        material.density, material.youngs_modulus, material.poisson_ratio)
+    assert (soil.diameter_min, soil.diameter_max) == pytest.approx(cmu_sand.TWIN_DIAMETERS)
