@@ -210,3 +210,26 @@ def test_calibration_objective_on_known_curves():
     chosen = best([{"plates": plates(0.5), "repose_deg": 29.0, "id": 1}, {"plates": plates(0.9), "repose_deg": 28.0,
                                                                             "id": 2}])
     assert chosen["id"] == 2
+
+
+def test_cmu_sand_is_the_calibrations_choice():
+    """wheelsoil.parameters.cmu_sand is what the stored calibration chooses by its rule (docs/soillab_calibration.py):
+    the EPSD candidates, grid and verified surface minimum, scored again from their stored measurements
+    (soillab.objective.score), the least objective; the density is the one its bed was poured at."""
+    import json
+    from pathlib import Path
+
+    from wheelsoil.parameters import cmu_sand
+    from wheelsoil.soillab.objective import best
+
+    docs = Path(__file__).resolve().parent.parent / "docs" / "soillab"
+    rows = [json.loads(p.read_text()) for folder in ("calibration-epsd", "calibration-epsd-surface")
+            for p in sorted((docs / folder / "candidates").glob("*.json"))]
+    assert len(rows) == 10 and all(r["rolling_model"] == "epsd" for r in rows)
+    chosen = best(rows)
+    pair, material = cmu_sand.PARTICLE_PAIR, cmu_sand.PARTICLE_MATERIAL
+    assert (chosen["friction"], chosen["rolling_friction"], chosen["rolling_model"]) == (
+        pair.static_friction, pair.rolling_friction, pair.rolling_model)
+    assert chosen["density"] == material.density
+    assert chosen["objective"] == pytest.approx(cmu_sand.CALIBRATION["objective"], abs=5e-4)
+    assert chosen["repose_deg"] == pytest.approx(cmu_sand.CALIBRATION["repose_deg"], abs=0.05)
