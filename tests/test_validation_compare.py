@@ -98,3 +98,22 @@ def test_a_run_with_the_rigs_slip_pairs_with_the_trial_at_the_same_heading_slip(
     pd.DataFrame(table).to_csv(path / "summary.csv", index=False)
     sim = load_sweep_summary(path)
     np.testing.assert_allclose(sim.slip, [0.75, 0.5, heading_slip_from_travel(-0.5, 30.0)])
+
+
+def test_the_report_splits_the_residual_by_steering_angle(tmp_path):
+    """An offset only at 30 deg shows in the 30 deg row of the report's table and in no other angle's."""
+    from wheelsoil.validation.compare import write_comparison_report
+
+    measured = synthetic_measurements({}, np.random.default_rng(1), cond=_cond())
+    sim = _as_sweep_summary(measured, tmp_path / "sweep")
+    sim.responses["drawbar_pull"] = sim.responses["drawbar_pull"] + np.where(sim.slip_angle == 30.0, 5.0, 0.0)
+    f = write_comparison_report(compare(measured, sim), measured, sim, tmp_path / "report")
+    rows = {(g["group"], g["response"]): g["simulation"] for g in f["residuals_by_group"]}
+    spread = f["responses"]["drawbar_pull"]["spread"]
+    assert rows[("30", "drawbar_pull")]["bias"] == pytest.approx(5.0 / spread, rel=1e-9)
+    assert rows[("0", "drawbar_pull")]["bias"] == pytest.approx(0.0, abs=1e-12)
+    # kinds by the slip against the travel speed: at 30 deg a heading slip of 0.1 turns slower than it travels
+    driving = measured.kinds() == "driving"
+    share = np.mean(measured.slip_angle[driving] == 30.0)
+    assert rows[("driving", "drawbar_pull")]["bias"] == pytest.approx(5.0 / spread * share, rel=1e-9)
+    assert "| 30° | drawbar_pull |" in (tmp_path / "report" / "report.md").read_text()

@@ -114,6 +114,30 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
     return Comparison(pairs, unmatched, stats, trends)
 
 
+def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, findings: dict) -> list[str]:
+    """The residual (simulated - measured, over the response's measured spread) of the paired rows by kind of motion
+    (driving, braking, dragged) and by steering angle (:func:`~.residuals.residuals_by_group`); stored in
+    ``findings["residuals_by_group"]``."""
+    from .residuals import residuals_by_group
+
+    if not len(c.pairs):
+        return []
+    paired = data.select(c.pairs[:, 0])
+    res = {q: (simulated.responses[q][c.pairs[:, 1]] - data.responses[q][c.pairs[:, 0]]) / v["spread"]
+           for q, v in c.responses.items()}
+    groups = residuals_by_group({"simulation": res}, paired)
+    findings["residuals_by_group"] = groups
+    lines = ["", "By kind of motion and steering angle (residual over the measured spread; the trend is the residual's "
+             "rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
+             "| group | response | pairs | bias | RMS | trend with slip |", "|---|---|---|---|---|---|"]
+    for g in groups:
+        v = g["simulation"]
+        rho = "–" if v["slip_spearman"] is None else f"{v['slip_spearman']:+.2f}"
+        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
+        lines.append(f"| {label} | {g['response']} | {g['rows']} | {v['bias']:+.3f} | {v['rms']:.3f} | {rho} |")
+    return lines
+
+
 def write_comparison_report(c: Comparison, data: Measurements, simulated: Measurements, out, *, command: str = "") -> dict:
     """report.md, findings.json and measured_vs_simulated.png in ``out``; returns the findings."""
     from pathlib import Path
@@ -165,6 +189,7 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
             + "."]
     else:
         lines += ["", f"No residual trend reaches p < {TREND_P:g}."]
+    lines += _by_group_lines(c, data, simulated, findings)
     lines += ["", "![measured vs simulated](measured_vs_simulated.png)"]
     findings["report"] = str(write_markdown_and_json(out / "report.md", "\n".join(lines) + "\n",
                                                      out / "findings.json", findings))
