@@ -8,7 +8,7 @@ import numpy as np
 
 from wheelsoil.slip import WheelSpeeds
 
-__all__ = ["janosi_hanamoto", "resultant_shear", "shear_displacements", "wheel_speeds"]
+__all__ = ["janosi_hanamoto", "lateral_displacement", "resultant_shear", "tangential_displacement", "wheel_speeds"]
 
 
 def wheel_speeds(slip, slip_angle_deg, travel_slip) -> WheelSpeeds:
@@ -23,21 +23,25 @@ def wheel_speeds(slip, slip_angle_deg, travel_slip) -> WheelSpeeds:
     return WheelSpeeds(*(np.where(given, getattr(travel, k), getattr(heading, k)) for k in ("rim", "along", "across")))
 
 
-def shear_displacements(radius, theta_f, theta, speeds: WheelSpeeds, soil_flow):
-    """Shear displacements j_x, j_y [m] under the rim (rows: conditions; columns: theta [rad]; theta_f [rad] and the
-    soil flow eta per condition): seed 003 eqs. 11 and 14 in velocity components, j = int_theta^theta_f (slip
-    velocity) d theta' / omega,
+def tangential_displacement(radius, theta_f, theta, speeds: WheelSpeeds, soil_flow):
+    """Shear displacement j_x [m] along the rim (rows: conditions; columns: theta [rad]; theta_f [rad] and the soil
+    flow eta per condition): seed 003 eq. 11 in velocity components, j = int_theta^theta_f (slip velocity)
+    d theta' / omega,
 
-        j_x = r ((theta_f - theta)(1 - eta) r omega - v_x (sin theta_f - sin theta)) / (r omega)
-        j_y = r (theta_f - theta) |v_y| / (r omega),
+        j_x = r ((theta_f - theta)(1 - eta) r omega - v_x (sin theta_f - sin theta)) / (r omega),
 
-    which with v_x = (1 - i) r omega (driving) or r omega / (1 + i) (braking) and v_y = v_x tan beta are eqs. 12
-    and 16 on both branches, and stay defined at 90 deg and, through :func:`_per_rim`, for omega = 0."""
+    which with v_x = (1 - i) r omega (driving) or r omega / (1 + i) (braking) is eq. 12 on both branches, and stays
+    defined at 90 deg and, through :func:`_per_rim`, for omega = 0."""
     tf = theta_f[:, None]
-    rim, along, across = speeds.rim[:, None], speeds.along[:, None], np.abs(speeds.across)[:, None]
-    jx = radius * _per_rim((tf - theta) * (1.0 - soil_flow[:, None]) * rim - along * (np.sin(tf) - np.sin(theta)), rim)
-    jy = radius * _per_rim((tf - theta) * across, rim)
-    return jx, jy
+    rim = speeds.rim[:, None]
+    rate = (tf - theta) * (1.0 - soil_flow[:, None]) * rim - speeds.along[:, None] * (np.sin(tf) - np.sin(theta))
+    return radius * _per_rim(rate, rim)
+
+
+def lateral_displacement(radius, theta_f, theta, speeds: WheelSpeeds):
+    """Shear displacement j_y [m] along the axle: seed 003 eq. 14 in velocity components,
+    j_y = r (theta_f - theta) |v_y| / (r omega), eq. 16 (v_y = v_x tan beta) where tan beta is finite."""
+    return radius * _per_rim((theta_f[:, None] - theta) * np.abs(speeds.across)[:, None], speeds.rim[:, None])
 
 
 def _per_rim(displacement_rate, rim):
@@ -47,6 +51,8 @@ def _per_rim(displacement_rate, rim):
     wheel dragged sideways at 90 deg). The independent shear form is discontinuous there (an arbitrarily slow
     tangential slide at 89.99 deg already mobilises the full strength along x); the resultant form, which shares
     one strength along the slip velocity, is not."""
+    if np.all(rim > 0.0):  # the common case: every wheel turns
+        return displacement_rate / rim
     rim = np.broadcast_to(rim, np.shape(displacement_rate))
     turning = rim > 0.0
     sliding = np.where(displacement_rate == 0.0, 0.0, np.copysign(np.inf, displacement_rate))

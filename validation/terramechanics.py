@@ -58,7 +58,7 @@ from wheelsoil.gravity import EARTH_GRAVITY
 from wheelsoil.slip import WheelSpeeds
 
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
-from .shear import janosi_hanamoto, resultant_shear, shear_displacements, wheel_speeds
+from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
 
 __all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
@@ -354,12 +354,13 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
 
     # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
     eta = np.clip(soil.soil_flow + soil.soil_flow_gravity * (1.0 - g / EARTH_GRAVITY), 0.0, 0.95)
-    jx, jy = shear_displacements(r, theta_f, theta, speeds, eta)
+    jx = tangential_displacement(r, theta_f, theta, speeds, eta)
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
     k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
     resultant = soil.shear_form == "resultant"
     if resultant:
-        tau_x, tau_y = resultant_shear(strength, jx, jy, k_x, speeds, eta, theta)
+        tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(r, theta_f, theta, speeds), k_x, speeds, eta,
+                                       theta)
     else:
         tau_x = janosi_hanamoto(strength, jx, k_x)
     fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
@@ -371,7 +372,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         return {"vertical_force": fz}
     if not resultant:  # the lateral shear is not needed for the sinkage solve
         shear_modulus_y = np.broadcast_to(shear_modulus_y, i.shape)[:, None]
-        tau_y = janosi_hanamoto(strength, jy, shear_modulus_y)
+        tau_y = janosi_hanamoto(strength, lateral_displacement(r, theta_f, theta, speeds), shear_modulus_y)
 
     fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
