@@ -165,10 +165,25 @@ def main(argv=None) -> int:
     return 0
 
 
+def _rewrite_verdict(out: Path) -> None:
+    """A report's verdict section written again from its ``findings.json`` (the run is not repeated): the verdict's
+    wording is a function of the findings (:func:`wheelsoil.validation.report.verdict_lines`)."""
+    from wheelsoil.validation.report import verdict_lines
+
+    md = out / "report.md"
+    lines = md.read_text().split("\n")
+    start = lines.index("## Verdict") + 2
+    end = next(k for k in range(start, len(lines)) if not lines[k].startswith("- "))
+    lines[start:end] = [f"- {v}" for v in verdict_lines(json.loads((out / "findings.json").read_text()))]
+    md.write_text("\n".join(lines))
+
+
 def _rewrite_crossval(argv) -> int:
     """Stands in for the CLI with ``--tables-only``: a cross-validation's ``crossval.md`` is written again from
-    its ``crossval.json`` (the folds are not rerun); other examples are left as they are."""
+    its ``crossval.json`` (the folds are not rerun); a report's verdict from its ``findings.json``."""
     if "--cv" not in argv:
+        if "--periodic" not in argv and argv[1] not in ("synthetic-periodic",):
+            _rewrite_verdict(Path(argv[argv.index("--report") + 1]))
         return 0
     from wheelsoil.validation.crossval import write_cross_validation
     from wheelsoil.validation.measured import load_measurements

@@ -61,3 +61,18 @@ def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
     assert "--hidden 'magic'" in capsys.readouterr().err
     assert main(["validate", str(tmp_path / "missing.csv"), "--report", str(out)]) == EXIT_INPUT
     assert main(["validate", "synthetic", "--holdout", "speed=3", "--report", str(out)]) == EXIT_INPUT
+
+
+def test_a_rival_fitted_in_place_of_two_members_is_quoted_at_its_best():
+    """A drift fitted in place of each member of a pair appears twice among the rivals; the verdict quotes the fit
+    that withheld the name (the better), with the member it replaced."""
+    from wheelsoil.validation.report import verdict_lines
+
+    rival = dict(name="a1 ~ load", description="a1 varying linearly with load")
+    findings = {"accepted": [], "partial": [], "unexplained": [],
+                "baseline": {"unidentified": [], "at_bounds": {}},
+                "steps": [{"ambiguity": ["sidewall + theta_m_slip", "a1 ~ load"],
+                           "rivals": [dict(rival, replaces="theta_m_slip", bic_vs_accepted=-40.3),
+                                      dict(rival, replaces="sidewall", bic_vs_accepted=461.5)]}]}
+    line = next(v for v in verdict_lines(findings) if v.startswith("ambiguous"))
+    assert "a1 ~ load in place of theta_m_slip" in line and "-40.3" in line and "461.5" not in line

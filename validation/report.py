@@ -48,7 +48,8 @@ def verdict_lines(findings: dict) -> list[str]:
         close = [r for r in findings["steps"][c["step"]].get("rivals", []) if r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
         if close:
             lines.append("  but a generic drift fits about as well in its place: "
-                         + "; ".join(f"{r['description']} (ΔBIC {r['bic_vs_accepted']:+.1f} against it)" for r in close)
+                         + "; ".join(f"{r['description']} in place of {r['replaces']} (ΔBIC {r['bic_vs_accepted']:+.1f} "
+                                     "against it)" for r in close)
                          + f"; named because no drift fits better by more than {RIVAL_MARGIN:g}")
     for c in findings["partial"]:
         lines.append(f"partial: {c['name']} was accepted by the selection (ΔBIC {c['delta_bic']:+.1f}, removes "
@@ -60,11 +61,13 @@ def verdict_lines(findings: dict) -> list[str]:
         group = step["ambiguity"]
         if not group:
             continue
-        rivals = {r["name"]: r for r in step.get("rivals", [])}
+        rivals = {}
+        for r in step.get("rivals", []):  # sorted best first: a drift fitted in place of two members keeps its best
+            rivals.setdefault(r["name"], r)
         generic = [rivals[n] for n in group if n in rivals]
         if generic:
-            alternatives = "; ".join(f"{r['name']}: {r['description']}, ΔBIC {r['bic_vs_accepted']:+.1f} against it"
-                                     for r in generic)
+            alternatives = "; ".join(f"{r['name']} in place of {r['replaces']}: {r['description']}, ΔBIC "
+                                     f"{r['bic_vs_accepted']:+.1f} against it" for r in generic)
             lines.append(f"ambiguous: {group[0]} passes every check but is not named, because a generic drift explains "
                          f"the same residual better ({alternatives}); the data prefer another form to the "
                          "mechanism's")
