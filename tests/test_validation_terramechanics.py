@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from terramechanics_closed_forms import closed_form_integrals, linear_soil
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.validation.extensions import BASELINE_OFF
 from wheelsoil.validation.terramechanics import (
@@ -24,16 +25,7 @@ SAND = SoilParameters()  # seed 003 Table III, unit 1 (dry sand)
 
 def _linear_soil(**kw):
     """n = 1, theta_m = 0 (no rear region), cohesionless: stress integrals have closed forms."""
-    base = dict(cohesion=0.0, n0=1.0, n1=0.0, a1=0.0, a2=0.0, c3=0.0, kc_prime=0.0)
-    return replace(SAND, **(base | kw))
-
-
-def _closed_form_integrals(theta_f):
-    c, s = np.cos(theta_f), np.sin(theta_f)
-    a = theta_f / 2 + np.sin(2 * theta_f) / 4 - c * s  # int_0^tf (cos t - cos tf) cos t dt
-    b = (1 - c) ** 2 / 2  # int_0^tf (cos t - cos tf) sin t dt
-    t = s - theta_f * c  # int_0^tf (cos t - cos tf) dt
-    return a, b, t
+    return linear_soil(SAND, **kw)
 
 
 @pytest.mark.parametrize("sinkage", [0.005, 0.02, 0.06])
@@ -44,7 +36,7 @@ def test_pure_compaction_matches_the_closed_form(sinkage):
     out = contact_forces(soil, WHEEL, sinkage, 0.0, 0.0, g)
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
-    a, bb, _ = _closed_form_integrals(np.arccos(1 - sinkage / r))
+    a, bb, _ = closed_form_integrals(np.arccos(1 - sinkage / r))
     assert out["vertical_force"][0] == pytest.approx(r * b * k * a, rel=1e-9)
     assert out["drawbar_pull"][0] == pytest.approx(-r * b * k * bb, rel=1e-6)
 
@@ -57,7 +49,7 @@ def test_fully_mobilised_shear_matches_the_closed_form():
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
     mu = np.tan(np.radians(soil.friction_angle))
-    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    a, bb, t = closed_form_integrals(np.arccos(1 - z / r))
     assert out["drawbar_pull"][0] == pytest.approx(r * b * k * (mu * a - bb), rel=1e-6)
     assert out["vertical_force"][0] == pytest.approx(r * b * k * (mu * bb + a), rel=1e-6)
     assert out["torque"][0] == pytest.approx(r * r * b * k * mu * t, rel=1e-6)
@@ -80,7 +72,7 @@ def test_resultant_shear_is_the_classical_form_straight_ahead_and_shares_the_str
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
     mu = np.tan(np.radians(soil.friction_angle))
-    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    a, bb, t = closed_form_integrals(np.arccos(1 - z / r))
     out = contact_forces(replace(soil, shear_form="resultant"), WHEEL, z, 0.5, 89.99, g)
     assert abs(out["lateral_force"][0]) == pytest.approx(r * b * k * mu * t, rel=1e-3)
     assert out["drawbar_pull"][0] == pytest.approx(-r * b * k * bb, rel=1e-3)

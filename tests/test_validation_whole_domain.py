@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from terramechanics_closed_forms import closed_form_integrals, linear_soil
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.slip import WheelSpeeds, heading_slip_from_travel
 from wheelsoil.validation.terramechanics import (
@@ -24,17 +25,8 @@ QUANTITIES = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sink
 
 
 def _linear_soil(**kw):
-    """n = 1, theta_m = 0 (no rear region), cohesionless, no side terms: the stress integrals have closed forms."""
-    base = dict(cohesion=0.0, n0=1.0, n1=0.0, a1=0.0, a2=0.0, c3=0.0, kc_prime=0.0, sidewall_scale=0.0)
-    return replace(SAND, **(base | kw))
-
-
-def _closed_form_integrals(theta_f):
-    c, s = np.cos(theta_f), np.sin(theta_f)
-    a = theta_f / 2 + np.sin(2 * theta_f) / 4 - c * s  # int_0^tf (cos t - cos tf) cos t dt
-    b = (1 - c) ** 2 / 2  # int_0^tf (cos t - cos tf) sin t dt
-    t = s - theta_f * c  # int_0^tf (cos t - cos tf) dt
-    return a, b, t
+    """The linear soil (closed-form stress integrals) without side terms."""
+    return linear_soil(SAND, **({"sidewall_scale": 0.0} | kw))
 
 
 # --- the wheel's speeds ---------------------------------------------------------------------------------------
@@ -105,7 +97,7 @@ def test_dragged_wheel_slides_fully_on_the_closed_form():
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
     mu = np.tan(np.radians(soil.friction_angle))
-    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    a, bb, t = closed_form_integrals(np.arccos(1 - z / r))
     assert out["drawbar_pull"][0] == pytest.approx(-r * b * k * (mu * a + bb), rel=1e-6)
     assert out["vertical_force"][0] == pytest.approx(r * b * k * (a - mu * bb), rel=1e-6)
     assert out["torque"][0] == pytest.approx(-r * r * b * mu * k * t, rel=1e-6)
@@ -146,7 +138,7 @@ def test_frictionless_soil_resists_only_by_compaction_at_every_slip_and_angle():
     travel = np.array([-1.0, -0.6, 0.0, 0.4, 0.9])
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
-    _, bb, _ = _closed_form_integrals(np.arccos(1 - z / r))
+    _, bb, _ = closed_form_integrals(np.arccos(1 - z / r))
     for beta in (0.0, 45.0, 90.0):
         out = contact_forces(soil, WHEEL, z, np.nan, beta, g, travel_slip=travel)
         np.testing.assert_allclose(out["drawbar_pull"], -r * b * k * bb, rtol=1e-6)
@@ -165,7 +157,7 @@ def test_dragged_sideways_at_90_degrees_meets_compaction_ahead_and_full_shear_ac
     r, b = WHEEL.radius, WHEEL.width
     k = soil.density * g * b * soil.kphi_prime * (r / b)
     mu = np.tan(np.radians(soil.friction_angle))
-    a, bb, t = _closed_form_integrals(np.arccos(1 - z / r))
+    a, bb, t = closed_form_integrals(np.arccos(1 - z / r))
     for shear_form in ("independent", "resultant"):
         out = contact_forces(replace(soil, shear_form=shear_form), WHEEL, z, np.nan, [90.0, -90.0], g,
                              travel_slip=-1.0)
