@@ -191,8 +191,8 @@ def _rewrite_crossval(argv) -> int:
     out = Path(argv[argv.index("--report") + 1])
     cv = json.loads((out / "crossval.json").read_text())
     command = cv.pop("command", "")
-    cv.pop("provenance", None)
-    write_cross_validation(cv, load_measurements(argv[1]), out, command=command)
+    record = cv.pop("provenance", None)  # the run's own: the tables are new, the run is not
+    write_cross_validation(cv, load_measurements(argv[1]), out, command=command, provenance_record=record)
     return 0
 
 

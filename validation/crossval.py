@@ -98,8 +98,10 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
     return {"condition": by, "folds": folds, "found_in": {n: sum(n in f["found"] for f in folds) for n in names}}
 
 
-def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "") -> Path:
-    """``crossval.md`` and ``crossval.json`` in ``out``."""
+def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "",
+                           provenance_record: dict | None = None) -> Path:
+    """``crossval.md`` and ``crossval.json`` in ``out``; ``provenance_record``: the run's own, when the files are
+    written again from a stored run (default: this process's)."""
     out = Path(out)
     by = cv["condition"]
     lines = [f"# Leave-one-{by.replace('_', '-')}-out cross-validation: {data.name}", "",
@@ -123,6 +125,6 @@ def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, com
     lines += ["", "Found in how many folds: " + (", ".join(f"{k} {v} of {n}" for k, v in cv["found_in"].items())
                                                  or "nothing in any fold"), ""]
     md = out / "crossval.md"
-    write_markdown_and_json(md, "\n".join(lines), out / "crossval.json", {**cv, "command": command,
-                                                                           "provenance": provenance()}, default=float)
+    write_markdown_and_json(md, "\n".join(lines), out / "crossval.json", {
+        **cv, "command": command, "provenance": provenance_record or provenance()}, default=float)
     return md
