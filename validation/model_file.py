@@ -134,8 +134,9 @@ def write_predictions(model: SavedModel, data: Measurements, out: str | Path) ->
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     preds = {w: model.predict(data, which=w) for w in ("baseline", "final")}
-    header = ["slip", "slip_angle_deg", "vertical_load_N", "gravity_m_s2", "passes", "wheel_radius_m", "group"]
-    cols = [data.slip, data.slip_angle, data.load, data.gravity, data.passes, data.radius, data.group]
+    header = ["slip", "travel_slip", "slip_angle_deg", "vertical_load_N", "gravity_m_s2", "passes", "wheel_radius_m",
+              "group"]
+    cols = [data.slip, data.travel_slip, data.slip_angle, data.load, data.gravity, data.passes, data.radius, data.group]
     for q in model.responses:
         unit = GENERIC_COLUMNS[q].rsplit("_", 1)[-1]
         header += [f"measured_{q}_{unit}", f"classical_{q}_{unit}", f"model_{q}_{unit}"]
