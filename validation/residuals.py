@@ -57,7 +57,7 @@ def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measureme
     models: model name -> response -> residual over all rows (NaN where unmeasured). Returns one dict per (group,
     response): "by" ("motion" or "slip_angle"), "group", "response", "rows", and per model "bias", "rms" and
     "slip_spearman" (the residual's rank correlation with the heading slip inside the group; None with fewer than 4
-    rows or one slip)."""
+    rows, one slip or a constant residual)."""
     out = []
     groups = [("motion", k, data.kinds() == k) for k in ("driving", "braking", "dragged")]
     angles = np.round(np.asarray(data.slip_angle, float), 1)
@@ -74,7 +74,7 @@ def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measureme
                     break
                 rho = None
                 slip = np.asarray(data.slip, float)[ok]
-                if ok.sum() >= 4 and np.ptp(slip) > 0:
+                if ok.sum() >= 4 and np.ptp(slip) > 0 and np.ptp(r[ok]) > 0:
                     rho = float(spearmanr(slip, r[ok])[0])
                 row[name] = {"bias": float(np.mean(r[ok])), "rms": float(np.sqrt(np.mean(r[ok] ** 2))),
                              "slip_spearman": rho}
