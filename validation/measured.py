@@ -20,7 +20,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
 from wheelsoil.parameters import cmu_k10
-from wheelsoil.slip import WheelSpeeds, heading_slip_from_travel
+from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
@@ -173,17 +173,6 @@ ROW_KINDS = ("driving", "braking", "dragged")
 #: A row whose travel slip is above this is free rolling or driving, not braking: the CMU rig's free-rolling rows
 #: (rim speed set equal to the carriage's) record -0.003 to +0.003 from the carriage's speed jitter.
 FREE_ROLLING_SLIP = -0.01
-
-
-def travel_slip_from_heading(slip, slip_angle_deg) -> np.ndarray:
-    """The slip against the whole travel speed of rows given by their heading slip (NaN at 90 deg and where the
-    heading slip is missing or outside [-1, 1): those rows cannot say it)."""
-    i = np.asarray(slip, float)
-    beta = np.asarray(slip_angle_deg, float)
-    i, beta = np.broadcast_arrays(i, beta)
-    ok = np.isfinite(i) & np.isfinite(beta) & (i >= -1.0) & (i < 1.0) & (np.abs(beta) < 90.0)
-    out = WheelSpeeds.from_heading_slip(np.where(ok, i, 0.0), np.where(ok, beta, 0.0)).travel_slip
-    return np.where(ok, out, np.nan)
 
 
 #: The columns of a CMU trial file (after the unit suffix is split off).
@@ -444,7 +433,7 @@ def _check_motion(data: Measurements, source) -> None:
     slip of the same row."""
     slip, beta, travel = (np.asarray(getattr(data, k), float) for k in ("slip", "slip_angle", "travel_slip"))
     given = np.isfinite(travel)
-    heading = np.where(given, WheelSpeeds.from_travel_slip(np.where(given, travel, 0.0), beta).heading_slip, np.nan)
+    heading = np.where(given, heading_slip_from_travel(np.where(given, travel, 0.0), beta), np.nan)
     for column, bad, allowed in (
         ("slip_angle", ~(np.abs(beta) <= 90.0), "-90 <= slip_angle <= 90 deg"),
         ("slip", ~((slip >= -1.0) & (slip <= 1.0)), "-1 <= slip <= 1"),

@@ -55,7 +55,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.gravity import EARTH_GRAVITY
 
-from wheelsoil.slip import WheelSpeeds
+from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
 from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
@@ -276,7 +276,7 @@ def _conditions(slip, slip_angle, load, gravity, passes=1.0, travel_slip=None):
             raise WheelsoilInputError(f"{name}[{k}] = {float(a[k])!r} is out of range: allowed {allowed}")
     travel = np.where(has_travel, travel, 0.0)
     if travel_given:  # the heading slip the travel slip gives, checked against one given with it
-        heading = WheelSpeeds.from_travel_slip(travel, beta_deg).heading_slip
+        heading = heading_slip_from_travel(travel, beta_deg)
         both = has_travel & np.isfinite(slip)
         off = both & ~np.isclose(slip, heading, rtol=0.0, atol=1e-9)
         if off.any():
@@ -285,9 +285,8 @@ def _conditions(slip, slip_angle, load, gravity, passes=1.0, travel_slip=None):
                 f"slip[{k}] = {slip[k]:g} along the heading disagrees with travel_slip[{k}] = {travel[k]:g} at "
                 f"{beta_deg[k]:g} deg, which gives {heading[k]:.6g}; give one or make them agree")
         slip = np.where(has_travel, heading, slip)
-    if not has_travel.all():
-        travel = np.where(has_travel, travel, WheelSpeeds.from_heading_slip(
-            np.where(has_travel, 0.0, slip), np.where(has_travel, 0.0, beta_deg)).travel_slip)
+    if not has_travel.all():  # every row's slip along the heading is in range and below 90 deg here
+        travel = np.where(has_travel, travel, travel_slip_from_heading(slip, beta_deg))
     return arrays[0].shape, slip, np.radians(beta_deg), load, gravity, passes, travel
 
 

@@ -58,6 +58,18 @@ def heading_slip_from_travel(travel_slip, slip_angle_deg):
     return out if out.ndim else float(out)
 
 
+def travel_slip_from_heading(slip, slip_angle_deg) -> np.ndarray:
+    """The slip against the whole travel speed (the rig's) of a wheel given by its slip along the heading: the
+    converse of :func:`heading_slip_from_travel`, NaN at 90 deg and where the heading slip is missing or outside
+    [-1, 1) (those rows cannot say it). Arrays broadcast; degrees."""
+    i = np.asarray(slip, float)
+    beta = np.asarray(slip_angle_deg, float)
+    i, beta = np.broadcast_arrays(i, beta)
+    ok = np.isfinite(i) & np.isfinite(beta) & (i >= -1.0) & (i < 1.0) & (np.abs(beta) < 90.0)
+    out = WheelSpeeds.from_heading_slip(np.where(ok, i, 0.0), np.where(ok, beta, 0.0)).travel_slip
+    return np.where(ok, out, np.nan)
+
+
 def _cos(beta_rad):
     c = np.cos(beta_rad)
     return np.where(np.abs(c) < COS_ZERO, 0.0, c)
