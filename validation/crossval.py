@@ -37,9 +37,8 @@ def levels(data: Measurements, by: str) -> list:
     return out
 
 
-def _fold_key(data: Measurements, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
-    """What a saved fold must match to be kept: the data (a digest of every condition and response), the held-out
-    level, the responses, the seed, the bootstrap size and the starting soil."""
+def _data_digest(data: Measurements) -> str:
+    """A digest of every condition and response of ``data`` (what a saved fold's data must match)."""
     digest = hashlib.sha256()
     for key in ("slip", "slip_angle", "load", "gravity", "passes", "radius", "width", "grouser_height",
                 "grouser_count", "travel_slip"):
@@ -47,7 +46,13 @@ def _fold_key(data: Measurements, by: str, level, responses, seed: int, bootstra
     for q in sorted(data.responses):
         digest.update(q.encode() + np.ascontiguousarray(data.responses[q], float).tobytes())
     digest.update("|".join(map(str, data.group)).encode())
-    return {"data": digest.hexdigest()[:20], "condition": by, "level": level if isinstance(level, str) else float(level),
+    return digest.hexdigest()[:20]
+
+
+def _fold_key(digest: str, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
+    """What a saved fold must match to be kept: the data (:func:`_data_digest`), the held-out level, the responses,
+    the seed, the bootstrap size and the starting soil."""
+    return {"data": digest, "condition": by, "level": level if isinstance(level, str) else float(level),
             "responses": list(responses), "seed": seed, "bootstrap": bootstrap,
             "start": None if start is None else start.to_dict()}
 
@@ -62,11 +67,12 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
     finished folds there and reuse those that match (module docstring)."""
     values = np.asarray(getattr(data, by))
     folds = []
+    digest = _data_digest(data) if resume_dir is not None else ""
     for k, level in enumerate(levels(data, by)):
         mask = values == level
         saved = None
         if resume_dir is not None:
-            key = _fold_key(data, by, level, responses, seed, bootstrap, start)
+            key = _fold_key(digest, by, level, responses, seed, bootstrap, start)
             saved = Path(resume_dir) / f"fold-{k}.json"
             if saved.is_file():
                 kept = json.loads(saved.read_text())

@@ -16,7 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from .terramechanics import DRIFT_FIELDS, DRIFT_MEASURES, RELATIVE_DRIFTS
+from .terramechanics import DRIFT_FIELDS, DRIFT_MEASURES, RELATIVE_DRIFTS, drift_conditions
 
 
 @dataclass(frozen=True)
@@ -221,10 +221,10 @@ def drift_rival(field: str, condition: str) -> Extension:
 def varied_conditions(data) -> tuple[str, ...]:
     """The conditions of :data:`~.terramechanics.DRIFT_MEASURES` whose measure varies over ``data``'s rows (a drift
     along a constant condition is the classical parameter again)."""
-    values = {"slip": np.abs(data.slip), "slip_angle": np.abs(np.sin(np.radians(data.slip_angle))),
-              "gravity": data.gravity, "passes": data.passes, "load": data.load, "radius": data.radius,
-              "width": data.width}
-    return tuple(c for c in DRIFT_MEASURES if np.ptp(np.asarray(values[c], float)) > 0.0)
+    rows = drift_conditions(*(np.asarray(v, float) for v in (data.slip, np.radians(data.slip_angle), data.gravity,
+                                                              data.passes, data.load, data.radius, data.width)))
+    return tuple(c for c, measure in DRIFT_MEASURES.items()
+                 if np.ptp(measure({**rows, "reference": drift_reference(data, c)})) > 0.0)
 
 
 def drift_reference(data, condition: str) -> float:
