@@ -97,7 +97,7 @@ def main(argv=None) -> int:
     from wheelsoil.validation.calibration import calibrate_baseline, model_responses, response_scales
     from wheelsoil.validation.extensions import BASELINE_OFF
     from wheelsoil.validation.measured import load_cmu_trials, row_counts
-    from wheelsoil.validation.residuals import residuals_by_group
+    from wheelsoil.validation.residuals import group_table, residuals_by_group
     from wheelsoil.validation.terramechanics import SoilParameters
 
     out = Path(args.out)
@@ -138,12 +138,9 @@ def main(argv=None) -> int:
               "their forces are the model's at that sinkage): " + "; ".join(
                   f"{m}: {int(u.sum())} ({', '.join(f'{int((u & (kinds == k)).sum())} {k}' for k in ('driving', 'braking', 'dragged'))})"
                   for m, u in unsupported.items())]
-    lines += ["", "By kind of motion and steering angle (bias and RMS, normalised as above):", "",
-              "| group | response | rows | lab: bias / RMS | fitted: bias / RMS |", "|---|---|---|---|---|"]
-    for g in groups:
-        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
-        lines.append(f"| {label} | {g['response']} | {g['rows']} | {g['lab']['bias']:+.3f} / {g['lab']['rms']:.3f} | "
-                     f"{g['fitted']['bias']:+.3f} / {g['fitted']['rms']:.3f} |")
+    lines += ["", "By kind of motion and steering angle (bias and RMS, normalised as above; fitted → lab, the classical "
+              "model fitted to the trials, then on the lab's soil; the trend is the lab model's residual's rank "
+              "correlation with slip inside the group):", "", *group_table(groups, ("fitted", "lab"))]
 
     plt = pyplot()
     angles = np.unique(data.slip_angle)

@@ -118,7 +118,7 @@ def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, 
     """The residual (simulated - measured, over the response's measured spread) of the paired rows by kind of motion
     (driving, braking, dragged) and by steering angle (:func:`~.residuals.residuals_by_group`); stored in
     ``findings["residuals_by_group"]``."""
-    from .residuals import residuals_by_group
+    from .residuals import group_table, residuals_by_group
 
     if not len(c.pairs):
         return []
@@ -127,15 +127,9 @@ def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, 
            for q, v in c.responses.items()}
     groups = residuals_by_group({"simulation": res}, paired)
     findings["residuals_by_group"] = groups
-    lines = ["", "By kind of motion and steering angle (residual over the measured spread; the trend is the residual's "
-             "rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
-             "| group | response | pairs | bias | RMS | trend with slip |", "|---|---|---|---|---|---|"]
-    for g in groups:
-        v = g["simulation"]
-        rho = "–" if v["slip_spearman"] is None else f"{v['slip_spearman']:+.2f}"
-        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
-        lines.append(f"| {label} | {g['response']} | {g['rows']} | {v['bias']:+.3f} | {v['rms']:.3f} | {rho} |")
-    return lines
+    return ["", "By kind of motion and steering angle (residual over the measured spread; the trend is the residual's "
+            "rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
+            *group_table(groups, ("simulation",), count="pairs")]
 
 
 def write_comparison_report(c: Comparison, data: Measurements, simulated: Measurements, out, *, command: str = "") -> dict:

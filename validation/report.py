@@ -23,7 +23,7 @@ from .discovery import (
     model_responses,
 )
 from .measured import Measurements
-from .residuals import residuals_by_group
+from .residuals import group_table, residuals_by_group
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
 
@@ -86,13 +86,14 @@ def verdict_lines(findings: dict) -> list[str]:
     return lines
 
 
-def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndarray, path: Path) -> None:
-    """Predicted against measured, classical and final model, training and held-out rows."""
+def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndarray, predictions: dict,
+              path: Path) -> None:
+    """Predicted against measured, classical and final model (``predictions``: "classical" and "final", each
+    response -> every row), training and held-out rows."""
     plt = pyplot()
-    models = [("classical", d.baseline.soil)]
+    preds = [("classical", predictions["classical"])]
     if findings["final"]["mechanisms"]:
-        models.append(("+ " + " + ".join(findings["final"]["mechanisms"]), d.final.soil))
-    preds = [(label, model_responses(soil, data)) for label, soil in models]
+        preds.append(("+ " + " + ".join(findings["final"]["mechanisms"]), predictions["final"]))
     fig, axes = plt.subplots(1, len(d.responses), figsize=(4.2 * len(d.responses), 4), squeeze=False)
     for ax, q in zip(axes[0], d.responses):
         unit, k = UNITS[q]
@@ -111,10 +112,10 @@ def plot_fits(findings: dict, d: Discovery, data: Measurements, heldout: np.ndar
     _save(fig, path)
 
 
-def plot_residuals(findings: dict, d: Discovery, data: Measurements, path: Path) -> None:
-    """Final-model residuals against the condition that carries most of each response's remaining trend."""
+def plot_residuals(findings: dict, d: Discovery, data: Measurements, pred: dict, path: Path) -> None:
+    """Final-model residuals (``pred``: its predictions, response -> every row) against the condition that carries
+    most of each response's remaining trend."""
     plt = pyplot()
-    pred = model_responses(d.final.soil, data)
     unexplained = {u["response"]: u for u in findings["unexplained"]}
     fig, axes = plt.subplots(1, len(d.responses), figsize=(4.2 * len(d.responses), 3.6), squeeze=False)
     for ax, q in zip(axes[0], d.responses):
@@ -162,28 +163,14 @@ def plot_candidates(findings: dict, path: Path) -> None:
     _save(fig, path)
 
 
-def _row_residuals(soil, d: Discovery, data: Measurements) -> dict[str, np.ndarray]:
-    """(model - measured) / training scale per response over every row (training and held out; NaN unmeasured)."""
-    pred = model_responses(soil, data)
-    return {q: (pred[q] - data.responses[q]) / d.scales[q] for q in d.responses}
-
-
 def _group_lines(groups: list[dict]) -> list[str]:
     """The report's table of residuals by kind of motion and by steering angle."""
     if not groups:
         return []
-    lines = ["### By kind of motion and steering angle", "",
-             "Every row (training and held out), residual normalised as above: mean (bias) and RMS, classical → final, "
-             "and the final residual's rank correlation with slip inside the group (– with fewer than 4 rows).", "",
-             "| group | response | rows | bias, classical → final | RMS, classical → final | trend with slip |",
-             "|---|---|---|---|---|---|"]
-    for g in groups:
-        c, f = g["classical"], g["final"]
-        rho = "–" if f["slip_spearman"] is None else f"{f['slip_spearman']:+.2f}"
-        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
-        lines.append(f"| {label} | {g['response']} | {g['rows']} | {c['bias']:+.3f} → {f['bias']:+.3f} | "
-                     f"{c['rms']:.3f} → {f['rms']:.3f} | {rho} |")
-    return lines + [""]
+    return ["### By kind of motion and steering angle", "",
+            "Every row (training and held out), residual normalised as above: mean (bias) and RMS, classical → final, "
+            "and the final residual's rank correlation with slip inside the group (– with fewer than 4 rows).", "",
+            *group_table(groups, ("classical", "final")), ""]
 
 
 def _parameter_rows(table: list[dict]) -> list[str]:
@@ -202,10 +189,11 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
     out.mkdir(parents=True, exist_ok=True)
     findings = {"title": title, "data": data.name, "rows": len(data), "notes": data.notes, "command": command,
                 "excluded": excluded, **d.to_dict(), **(extra or {}), "provenance": provenance()}
-    findings["residuals_by_group"] = residuals_by_group(
-        {"classical": _row_residuals(d.baseline.soil, d, data), "final": _row_residuals(d.final.soil, d, data)}, data)
-    plot_fits(findings, d, data, heldout, out / "fits.png")
-    plot_residuals(findings, d, data, out / "residuals.png")
+    preds = {"classical": model_responses(d.baseline.soil, data), "final": model_responses(d.final.soil, data)}
+    findings["residuals_by_group"] = residuals_by_group(  # (model - measured) / training scale, every row
+        {m: {q: (p[q] - data.responses[q]) / d.scales[q] for q in d.responses} for m, p in preds.items()}, data)
+    plot_fits(findings, d, data, heldout, preds, out / "fits.png")
+    plot_residuals(findings, d, data, preds["final"], out / "residuals.png")
     if findings["steps"]:
         plot_candidates(findings, out / "candidates.png")
     base = findings["baseline"]

@@ -83,6 +83,22 @@ def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measureme
     return out
 
 
+def group_table(groups: list[dict], models: tuple[str, ...], *, count: str = "rows") -> list[str]:
+    """Markdown table of :func:`residuals_by_group`'s rows: each model's bias and RMS (``a → b`` for several, in the
+    order of ``models``) and the last model's trend with slip (– where it has none); ``count`` names the row count's
+    column."""
+    over = "" if len(models) == 1 else ", " + " → ".join(models)
+    lines = [f"| group | response | {count} | bias{over} | RMS{over} | trend with slip |", "|---|---|---|---|---|---|"]
+    for g in groups:
+        rho = g[models[-1]]["slip_spearman"]
+        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
+        bias = " → ".join(f"{g[m]['bias']:+.3f}" for m in models)
+        rms = " → ".join(f"{g[m]['rms']:.3f}" for m in models)
+        lines.append(f"| {label} | {g['response']} | {g['rows']} | {bias} | {rms} | "
+                     f"{'–' if rho is None else f'{rho:+.2f}'} |")
+    return lines
+
+
 def _design(x: dict[str, np.ndarray]) -> tuple[np.ndarray, list[tuple[str, ...]]]:
     """Quadratic design (without intercept) over the standardised columns of ``x``: each term names the
     conditions it involves."""
