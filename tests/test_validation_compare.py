@@ -117,3 +117,21 @@ def test_the_report_splits_the_residual_by_steering_angle(tmp_path):
     share = np.mean(measured.slip_angle[driving] == 30.0)
     assert rows[("driving", "drawbar_pull")]["bias"] == pytest.approx(5.0 / spread * share, rel=1e-9)
     assert "| 30° | drawbar_pull |" in (tmp_path / "report" / "report.md").read_text()
+
+
+def test_a_run_without_a_steady_state_is_left_out_and_named(tmp_path):
+    """A run whose steady detector found no steady window reports no number: the sweep loader drops it and says so;
+    a sweep with no steady run is refused."""
+    measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    sim = _as_sweep_summary(measured, tmp_path / "sweep")
+    table = pd.read_csv(tmp_path / "sweep" / "summary.csv")
+    table["case"] = [f"case-{k}" for k in range(len(table))]
+    table["steady"] = [k != 3 for k in range(len(table))]
+    table.to_csv(tmp_path / "sweep" / "summary.csv", index=False)
+    kept = load_sweep_summary(tmp_path / "sweep")
+    assert len(kept) == len(sim) - 1 and "1 not steady, left out: case-3" in kept.notes
+    np.testing.assert_array_equal(kept.slip, np.delete(sim.slip, 3))
+    table["steady"] = False
+    table.to_csv(tmp_path / "sweep" / "summary.csv", index=False)
+    with pytest.raises(WheelsoilInputError, match="none of its 18 runs reached a steady state"):
+        load_sweep_summary(tmp_path / "sweep")

@@ -7,18 +7,21 @@ import pytest
 
 from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
 from wheelsoil.validation.discovery import RIVAL_MARGIN
-from wheelsoil.validation.extensions import EXTENSIONS
+from wheelsoil.validation.extensions import CATALOGUE_DRIFTS, DRIFT_FIELDS, EXTENSIONS
 from wheelsoil.validation.workflow import validate
 
 
 @pytest.mark.slow
 def test_cmu_large_steering_angles_sidewall_helps_but_is_not_named(measured_dir, tmp_path):
-    """Calibrated on steering angles up to 45 deg, the classical model misses the lateral force at 60 deg.
-    Schwanghart's sidewall resistance (seed 003 eq. 19) predicts the held-out angle better, beyond two bootstrap
-    standard deviations, but it removes a small share of the systematic residual on the training angles: the
-    model's error there follows the slip and the wheel in forms no candidate holds. The honest verdict is
-    "nothing named; these trends unexplained", with the baseline's parameters at their bounds flagged."""
-    findings = validate(os.path.join(measured_dir, "cmu_3d_terramechanics"), report=tmp_path, holdout="slip_angle=60")
+    """On the driving rows (``--domain driving``), calibrated on the other steering angles, the classical model
+    misses the lateral force at 60 deg. Schwanghart's sidewall resistance (seed 003 eq. 19) predicts the held-out
+    angle better, beyond two bootstrap standard deviations, but it removes a small share of the systematic residual
+    on the training angles: the model's error there follows the steering angle in forms no candidate holds. The
+    honest verdict is "nothing named; these trends unexplained", with the baseline's parameters at their bounds
+    flagged. (On every row, the default, the sidewall's held-out gain at 60 deg is gone, -0.08 +- 0.03, and nothing
+    is named either: docs/validation/cmu-large-steering, too long a run for this tier.)"""
+    findings = validate(os.path.join(measured_dir, "cmu_3d_terramechanics"), report=tmp_path, holdout="slip_angle=60",
+                        domain="driving")
     sidewall = next(c for c in findings["steps"][0]["candidates"] if c["name"] == "sidewall")
     assert sidewall["gain"] > 2 * sidewall["gain_std"] > 0
     assert sidewall["gain"] == max(c["gain"] for c in findings["steps"][0]["candidates"])
@@ -44,10 +47,15 @@ def test_validate_command_on_synthetic_data_and_bad_input(tmp_path, capsys):
             assert all(type(v) is bool for v in c["checks"].values())
     report = (out / "report.md").read_text()
     assert "Hidden: slip_sinkage" in report
-    # named only after its generic rivals (a classical parameter drifting with slip) were fitted and fell short
+    # named only after its generic rivals were fitted and fell short: every classical field drifting along every
+    # condition the synthetic design varies (not only slip, the one slip_sinkage acts through), less the drifts that
+    # are catalogue mechanisms themselves
     rivals = findings["steps"][0]["rivals"]
-    assert {r["name"] for r in rivals} == {"cohesion ~ slip", "friction_angle ~ slip", "shear_modulus_x ~ slip",
-                                           "kc_prime ~ slip", "kphi_prime ~ slip"}
+    varied = ("slip", "slip_angle", "gravity", "load", "passes")
+    assert {r["name"] for r in rivals} == {f"{f} ~ {c}" for c in varied for f in DRIFT_FIELDS
+                                           if (f, c) not in CATALOGUE_DRIFTS}
+    assert {"cohesion ~ slip", "friction_angle ~ load", "kc_prime ~ passes", "a1 ~ slip_angle"} <= {
+        r["name"] for r in rivals}
     assert all(r["bic_vs_accepted"] >= -RIVAL_MARGIN for r in rivals) and "Generic rivals" in report
     # one truth: the terminal, the report's verdict and the JSON name the same mechanisms
     terminal = capsys.readouterr().out

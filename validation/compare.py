@@ -166,7 +166,8 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
     lines = [f"# {simulated.name} (DEM-FEM) against {data.name}", ""]
     if command:
         lines += [f"Reproduce: `{command}`", ""]
-    lines += [f"{len(c.pairs)} measured conditions have a simulated run at the same slip, slip angle, load, gravity, "
+    lines += [f"Simulated: {simulated.notes}.", "",
+              f"{len(c.pairs)} measured conditions have a simulated run at the same slip, slip angle, load, gravity, "
               f"pass and wheel; {len(c.unmatched)} have none and are left out.", "",
               "| response | pairs | bias | RMS error | bias / spread | RMS / spread | within 2σ |", "|---|---|---|---|---|---|---|"]
     for q, v in c.responses.items():

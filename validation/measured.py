@@ -360,7 +360,9 @@ def load_sweep_summary(path: str | Path) -> Measurements:
     deflection), the quantity the rigid-wheel model predicts; the lateral force keeps wheelsoil's sign
     (it opposes the lateral slip). Groups are the gravity levels ("1g", "moon" or the value). A case run with
     ``test.slip_speed = "travel"`` (the CMU rig's convention) has its slip converted to the heading's, as
-    :func:`load_cmu_file` converts the rig's, so simulated and measured rows pair at the same slip.
+    :func:`load_cmu_file` converts the rig's, so simulated and measured rows pair at the same slip. A run that did
+    not reach a detected steady state (``steady`` false) reports no number: it is left out, and ``notes`` says how
+    many were.
     """
     import pandas as pd
 
@@ -371,6 +373,14 @@ def load_sweep_summary(path: str | Path) -> Measurements:
         raise WheelsoilInputError(f"{path} does not exist: a sweep folder has summary.csv once 'wheelsoil batch' "
                                   "has finished cases")
     t = pd.read_csv(path)
+    not_steady = []
+    if "steady" in t.columns:
+        steady = t["steady"].astype(str).str.lower().isin(("true", "1", "1.0"))
+        not_steady = [str(v) for v in t.loc[~steady, "case"]] if "case" in t.columns else [""] * int((~steady).sum())
+        t = t.loc[steady].reset_index(drop=True)
+        if t.empty:
+            raise WheelsoilInputError(f"{path}: none of its {len(not_steady)} runs reached a steady state; there is "
+                                      "no simulated number to compare")
     needed = ["slip_set", "slip_angle_set", "load_set", "gravity", "wheel_radius", "wheel_width", "grouser_count",
               "grouser_height"] + [f"{src}_{k}" for src in SIMULATED_RESPONSES.values() for k in ("mean", "std")]
     missing = [c for c in needed if c not in t.columns]
@@ -391,7 +401,9 @@ def load_sweep_summary(path: str | Path) -> Measurements:
         grouser_count=col("grouser_count"), group=group.astype(str),
         responses={q: col(f"{src}_mean") for q, src in SIMULATED_RESPONSES.items()},
         std={q: col(f"{src}_std") for q, src in SIMULATED_RESPONSES.items()},
-        notes=f"{len(t)} DEM-FEM runs of the wheelsoil sweep summarised in {path}; sinkage is the tread sinkage",
+        notes=f"{len(t)} steady DEM-FEM runs of the wheelsoil sweep summarised in {path}"
+              + (f" ({len(not_steady)} not steady, left out: {', '.join(not_steady)})" if not_steady else "")
+              + "; sinkage is the tread sinkage",
         travel_slip=travel_slip,
     )
 
