@@ -15,9 +15,14 @@ the output): the shear deformation modulus K and the stress distribution's a1 (t
 every mechanism off. Beside it, for scale, the classical model fitted to all the trials (the calibration
 ``wheelsoil validate`` starts from, on every row): the gap between the two is what the lab's parameters miss.
 
+With ``--twin SWEEP`` (a ``wheelsoil batch`` folder of the CMU rig presets, e.g. ``cmu-trials-subset``) the third
+model joins them: the DEM--FEM twin on the lab's particles, its steady runs paired with the measured trials at the
+same wheel, steering angle, slip and load (``validation.compare.match_conditions``). The three are then scored on
+the paired trials only, the same rows for each, and the twin's points are drawn in the figure.
+
 Usage (from the repository root; a few minutes on 2 cores)::
 
-    python docs/validation_lab_model.py --out docs/validation/lab-parameters
+    python docs/validation_lab_model.py --out docs/validation/lab-parameters [--twin SWEEP]
 """
 
 import argparse
@@ -85,20 +90,62 @@ def _unsupported(soil, data) -> np.ndarray:
     return out
 
 
+def three_models(data, preds: dict, scales: dict, sweep: str) -> tuple[dict, list[str]]:
+    """The DEM--FEM twin's steady runs of ``sweep`` paired with the measured rows, and the three models' bias and
+    RMS error on those rows (normalised by the responses' measured spread), as Markdown lines."""
+    from wheelsoil.validation.compare import match_conditions
+    from wheelsoil.validation.measured import load_sweep_summary
+
+    simulated = load_sweep_summary(sweep)
+    pairs, _ = match_conditions(data, simulated)
+    rows, runs = pairs[:, 0], pairs[:, 1]
+    twin = {"sweep": str(sweep), "notes": simulated.notes, "paired": int(len(rows)), "measured_rows": rows,
+            "responses": {q: simulated.responses[q][runs] for q in RESPONSES},
+            "std": {q: simulated.std[q][runs] for q in RESPONSES}}
+    lines = [f"**The DEM-FEM twin** (`{sweep}`): {simulated.notes}. {len(rows)} measured trials have a twin run at "
+             "their wheel, steering angle, slip and load; the three models on those trials (bias and RMS error over "
+             "the measured spread; the within-2σ share counts the measured and the twin's standard deviations "
+             "together):", "",
+             "| response | DEM-FEM twin bias / RMS (within 2σ) | lab's soil bias / RMS | fitted to the trials bias / RMS |",
+             "|---|---|---|---|"]
+    scores = {}
+    for q in RESPONSES:
+        measured = data.responses[q][rows]
+        sigma = np.hypot(data.std[q][rows], twin["std"][q]) if q in data.std else twin["std"][q]
+        row = {}
+        for name, values in (("twin", twin["responses"][q]), ("lab", preds["lab"][q][rows]),
+                             ("fitted", preds["fitted"][q][rows])):
+            r = (values - measured) / scales[q]
+            row[name] = {"bias": float(np.mean(r)), "rms": float(np.sqrt(np.mean(r ** 2)))}
+        row["twin"]["within_2sigma"] = float(np.mean(np.abs(twin["responses"][q] - measured) <= 2 * sigma))
+        scores[q] = row
+        lines.append(f"| {q} | {row['twin']['bias']:+.3f} / {row['twin']['rms']:.3f} "
+                     f"({row['twin']['within_2sigma']:.0%}) | {row['lab']['bias']:+.3f} / {row['lab']['rms']:.3f} | "
+                     f"{row['fitted']['bias']:+.3f} / {row['fitted']['rms']:.3f} |")
+    twin["scores"] = scores
+    twin["trials"] = [{"wheel": str(data.group[k]), "slip_angle": float(data.slip_angle[k]),
+                       "travel_slip": float(data.travel_slip[k]),
+                       **{f"{q}_measured": float(data.responses[q][k]) for q in RESPONSES},
+                       **{f"{q}_twin": float(twin["responses"][q][i]) for q in RESPONSES}}
+                      for i, k in enumerate(rows)]
+    return twin, lines
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="docs/validation/lab-parameters")
     ap.add_argument("--data", default=str(MEASURED))
+    ap.add_argument("--twin", default=None, help="a sweep folder of the CMU rig presets: the DEM-FEM twin")
     args = ap.parse_args(argv)
 
     from wheelsoil.parameters import cmu_sand
-    from wheelsoil.plotting import pyplot
     from wheelsoil.provenance import provenance, write_markdown_and_json
     from wheelsoil.validation.calibration import calibrate_baseline, model_responses, response_scales
     from wheelsoil.validation.extensions import BASELINE_OFF
     from wheelsoil.validation.measured import load_cmu_trials, row_counts
     from wheelsoil.validation.residuals import group_table, residuals_by_group
     from wheelsoil.validation.terramechanics import SoilParameters
+    from wheelsoil.validation.trial_figure import ModelPoints, plot_trials
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -133,6 +180,10 @@ def main(argv=None) -> int:
               f"({', '.join(f'{q} {scales[q]:.2f} N' for q in RESPONSES)}):", "",
               "| response | lab's soil | fitted to the trials |", "|---|---|---|"]
     lines += [f"| {q} | {rms['lab'][q]:.3f} | {rms['fitted'][q]:.3f} |" for q in RESPONSES]
+    twin = None
+    if args.twin is not None:
+        twin, twin_lines = three_models(data, preds, scales, args.twin)
+        lines += ["", *twin_lines]
     kinds = data.kinds()
     lines += ["", "Rows where the model cannot carry the load at any sinkage up to 0.95 r (`predict`'s `supported` false; "
               "their forces are the model's at that sinkage): " + "; ".join(
@@ -142,33 +193,15 @@ def main(argv=None) -> int:
               "model fitted to the trials, then on the lab's soil; the trend is the lab model's residual's rank "
               "correlation with slip inside the group):", "", *group_table(groups, ("fitted", "lab"))]
 
-    plt = pyplot()
-    angles = np.unique(data.slip_angle)
-    fig, axes = plt.subplots(2, len(angles), figsize=(2.6 * len(angles), 5.6), sharey="row", squeeze=False)
-    for col, beta in enumerate(angles):
-        for row, q in enumerate(RESPONSES):
-            ax = axes[row, col]
-            for wheel, colour in (("grouser", "C0"), ("smooth", "C1")):
-                m = (data.slip_angle == beta) & (data.group == wheel)
-                if not m.any():
-                    continue
-                order = np.argsort(data.travel_slip[m])
-                s = data.travel_slip[m][order]
-                ax.errorbar(s, data.responses[q][m][order], yerr=data.std.get(q, np.zeros(len(data)))[m][order],
-                            fmt="o", ms=3, color=colour, capsize=1.5, label=f"{wheel}, measured")
-                ax.plot(s, preds["lab"][q][m][order], "-", color=colour, lw=1.2, label=f"{wheel}, lab's soil")
-                ax.plot(s, preds["fitted"][q][m][order], ":", color=colour, lw=1.2, label=f"{wheel}, fitted")
-            ax.set_title(f"{beta:g}°", fontsize=9)
-            if row == 1:
-                ax.set_xlabel("slip (rig's)")
-            if col == 0:
-                ax.set_ylabel(f"{q.replace('_', ' ')} [N]")
-    axes[0, 0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(out / "lab-vs-trials.png", dpi=100)
-    plt.close(fig)
+    points = None
+    if twin is not None:
+        points = {"DEM-FEM twin": ModelPoints(twin["measured_rows"], twin["responses"], twin["std"])}
+    plot_trials(data, {"lab's soil": preds["lab"], "fitted": preds["fitted"]}, out / "lab-vs-trials.png",
+                points=points)
     lines += ["", "![](lab-vs-trials.png)", ""]
-    findings = {"unsupported": {m: int(u.sum()) for m, u in unsupported.items()}, "lab_soil": soil.to_dict(), "fitted_soil": fitted.to_dict(), "reece_fit": reece, "rms": rms,
+    if twin is not None:
+        findings_twin = {k: v for k, v in twin.items() if k not in ("responses", "std", "measured_rows")}
+    findings = {"twin": findings_twin if twin is not None else None, "unsupported": {m: int(u.sum()) for m, u in unsupported.items()}, "lab_soil": soil.to_dict(), "fitted_soil": fitted.to_dict(), "reece_fit": reece, "rms": rms,
                 "scales": scales, "residuals_by_group": groups, "provenance": provenance()}
     write_markdown_and_json(out / "README.md", "\n".join(lines), out / "findings.json", findings, default=float)
     print("\n".join(lines))

@@ -1,0 +1,72 @@
+"""One figure of single-wheel trials against models: drawbar pull and lateral force over slip, a panel per steering
+angle, the measured points with their error bars, each model a line (or, for runs at some trials only, points)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .measured import Measurements
+
+RESPONSES = ("drawbar_pull", "lateral_force")
+#: Line styles of the models, in the order they are given.
+STYLES = ("-", ":", "--", "-.")
+
+
+@dataclass
+class ModelPoints:
+    """A model's values at some rows of the data only (e.g. the DEM--FEM runs): ``rows`` index the data;
+    ``responses`` and ``std`` hold one value per row of ``rows``."""
+
+    rows: np.ndarray
+    responses: dict
+    std: dict = field(default_factory=dict)
+
+
+def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *, points: dict[str, ModelPoints] | None = None,
+                responses=RESPONSES) -> Path:
+    """Write the figure to ``path``: ``lines`` maps a model's name to its predictions over every row (response ->
+    array), ``points`` a model's name to its :class:`ModelPoints`. Slip on the x axis is the rig's (against the
+    travel speed), wheels by colour (the data's groups)."""
+    from wheelsoil.plotting import pyplot
+
+    plt = pyplot()
+    slip = data.travel_slip if data.travel_slip is not None else data.slip
+    angles = np.unique(data.slip_angle)
+    fig, axes = plt.subplots(len(responses), len(angles), figsize=(2.6 * len(angles), 2.8 * len(responses)),
+                             sharey="row", squeeze=False)
+    for col, beta in enumerate(angles):
+        for row, q in enumerate(responses):
+            ax = axes[row, col]
+            for w, wheel in enumerate(np.unique(data.group)):
+                colour = f"C{w}"
+                m = (data.slip_angle == beta) & (data.group == wheel)
+                if not m.any():
+                    continue
+                order = np.argsort(slip[m])
+                s = slip[m][order]
+                std = data.std.get(q, np.zeros(len(data)))
+                ax.errorbar(s, data.responses[q][m][order], yerr=std[m][order], fmt="o", ms=3, color=colour,
+                            capsize=1.5, label=f"{wheel}, measured")
+                for k, (name, pred) in enumerate(lines.items()):
+                    ax.plot(s, pred[q][m][order], STYLES[k % len(STYLES)], color=colour, lw=1.2,
+                            label=f"{wheel}, {name}")
+                for name, p in (points or {}).items():
+                    hit = m[p.rows]
+                    if hit.any():
+                        ax.errorbar(slip[p.rows[hit]], p.responses[q][hit], yerr=p.std.get(q, None)[hit]
+                                    if q in p.std else None, fmt="s", ms=5, mfc="none", color=colour, capsize=1.5,
+                                    label=f"{wheel}, {name}")
+            ax.set_title(f"{beta:g}°", fontsize=9)
+            if row == len(responses) - 1:
+                ax.set_xlabel("slip (rig's)")
+            if col == 0:
+                ax.set_ylabel(f"{q.replace('_', ' ')} [N]")
+    axes[0, 0].legend(fontsize=6)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
