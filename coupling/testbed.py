@@ -290,8 +290,9 @@ class TestbedResult:
 def soil_headroom(bed_depth: float, wheel: WheelGeometry) -> float:
     """How far [m] the soil's domain reaches above the bed surface: above the wheel's top when it stands on the
     surface (2 (r + grouser height) + 0.1 m), and at least the bed depth. Grains that ride up in the grouser
-    pockets or on a steered wheel's berm stay in the domain; one that leaves it still means a blown-up run.
-    (At 0.25 m, a 20-deg steering run at smoke scale stopped at 6.1 s with a grain carried up at 0.5 m/s.)"""
+    pockets or on a steered wheel's berm stay in the domain. (At 0.25 m, a 20-deg steering run at smoke scale
+    stopped at 6.1 s with a grain carried up at 0.5 m/s; grains launched higher are counted, not fatal:
+    :meth:`~wheelsoil.granular.Scene.check_health`.)"""
     return max(bed_depth, 2.0 * (wheel.radius + wheel.grouser_height) + 0.1)
 
 
@@ -782,6 +783,8 @@ class Testbed:
             "t_released": loop["t_release"], "t_spin_up": loop["t_spin"], "t_wind_up": loop["t_windup"],
             "t_hold": loop["t_hold"], "wind_up_converged": bool(loop["windup_converged"]),
             "patch_shifts": int(self.patch.shifts) if self.patch is not None else 0,
+            # grains launched above the soil's domain at one health check, at most (Scene.check_health)
+            "most_grains_above_top": int(self.scene.most_above_top),
         }
         return TestbedResult(series=rows, summary=summary, spec=s, wheel=self.wheel, bed_summary=self.bed.summary(),
                              info=info, final_particles=particles, final_wheel_nodes=nodes,

@@ -142,11 +142,14 @@ def copy_vec3(src: nd_vec3, dst: nd_vec3):
 
 @ti.kernel
 def state_health(
-    x: nd_vec3, v: nd_vec3, omega: nd_vec3, mass: nd_f64, inertia: nd_f64, lo: vec3, hi: vec3, out: nd_f64
+    x: nd_vec3, v: nd_vec3, omega: nd_vec3, mass: nd_f64, inertia: nd_f64, lo: vec3, hi: vec3, top: ti.f64,
+    out: nd_f64
 ):
-    """out = [non-finite count, count outside [lo, hi], max speed^2, kinetic energy (trans. + rot.)]."""
+    """out = [non-finite count, count outside [lo, hi], max speed^2, kinetic energy (trans. + rot.), count inside
+    [lo, hi] but above ``top``]."""
     bad = 0.0
     outside = 0.0
+    above = 0.0
     vmax2 = 0.0
     energy = 0.0
     for i in x:
@@ -158,6 +161,8 @@ def state_health(
             bad += 1.0
         elif (p < lo).any() or (p > hi).any():
             outside += 1.0
+        elif p[2] > top:
+            above += 1.0
         u2 = u.norm_sqr()
         ti.atomic_max(vmax2, u2)
         energy += 0.5 * mass[i] * u2 + 0.5 * inertia[i] * w.norm_sqr()
@@ -165,6 +170,7 @@ def state_health(
     out[1] = outside
     out[2] = vmax2
     out[3] = energy
+    out[4] = above
 
 
 #: :func:`kick_drift` and :func:`kick` as compute graphs (same arguments; :mod:`wheelsoil.graph_launch`).
