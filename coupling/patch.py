@@ -128,6 +128,7 @@ class MovingPatch:
         self.removed = 0  # spheres of the rut removed, all shifts
         self.added = 0
         self.left_out = 0  # template spheres not placed because they overlapped crept soil at the rear face
+        self.thrown_out = 0  # grains thrown over an open end of the bin, removed (drop_thrown_out)
         self.center = None
 
     def check_start(self, start_x: float | None) -> float:
@@ -177,6 +178,19 @@ class MovingPatch:
         self._restore_pairs(scene, np.arange(first, scene.n_particles))
         self._hold_ends(scene)
         return d
+
+    def drop_thrown_out(self, scene) -> int:
+        """Remove the grains that have left the bin over one of its open ends (a grain launched from under the
+        wheel flies on its arc; behind the rear end it is soil of the old rut, which the next shift would remove
+        anyway). Returns how many; the scene's health check does not count x at open ends
+        (:attr:`~wheelsoil.granular.Scene.open_ends_x`)."""
+        x = scene.positions[:, 0]
+        inside = (x >= 0.0) & (x <= self.length)
+        if inside.all():
+            return 0
+        self._keep(scene, inside)
+        self.thrown_out += int((~inside).sum())
+        return int((~inside).sum())
 
     def _hold_ends(self, scene) -> None:
         x = scene.positions[:, 0]
@@ -232,12 +246,13 @@ class MovingPatch:
     # ------------------------------------------------------------------ checkpoints
     def state(self) -> dict:
         return {"shifted": self.shifted, "shifts": self.shifts, "removed": self.removed, "added": self.added,
-                "left_out": self.left_out, "center": self.center, "ids": self.ids.copy(),
+                "left_out": self.left_out, "thrown_out": self.thrown_out, "center": self.center, "ids": self.ids.copy(),
                 "expected": self.expected.copy()}
 
     def restore_state(self, state: dict) -> None:
         self.shifted = float(state["shifted"])
         self.shifts, self.removed, self.added = int(state["shifts"]), int(state["removed"]), int(state["added"])
         self.left_out = int(state["left_out"])
+        self.thrown_out = int(state.get("thrown_out", 0))  # absent from checkpoints written before it
         self.ids, self.expected = np.asarray(state["ids"], np.int64), np.asarray(state["expected"], float)
         self.center = float(state["center"])

@@ -571,6 +571,8 @@ class Testbed:
         if phase != "lower" and self.axle_damping > 0.0:
             self._apply_load(float(self.structure.hub_velocity[2]))
         self.scene.step(self.steps_per_sample)
+        if self.patch is not None:
+            self.patch.drop_thrown_out(self.scene)
         interval = self.steps_per_sample * self.dt
         loop["hub_angle"] += loop["hub_spin"] * interval
         row = self._measure(phase, interval)
@@ -785,6 +787,7 @@ class Testbed:
             "patch_shifts": int(self.patch.shifts) if self.patch is not None else 0,
             # grains launched above the soil's domain at one health check, at most (Scene.check_health)
             "most_grains_above_top": int(self.scene.most_above_top),
+            "patch_thrown_out": int(self.patch.thrown_out) if self.patch is not None else 0,
         }
         return TestbedResult(series=rows, summary=summary, spec=s, wheel=self.wheel, bed_summary=self.bed.summary(),
                              info=info, final_particles=particles, final_wheel_nodes=nodes,

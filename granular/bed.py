@@ -301,6 +301,7 @@ class Bed:
         if end_walls or periodic:
             scene.add_box_walls(material=s.wall_material, pair=s.wall_pair)
         else:
+            scene.open_ends_x = True
             lo, hi = scene.domain_min, scene.domain_max
             for point, normal in ((lo, (0, 0, 1)), (lo, (0, 1, 0)), (hi, (0, -1, 0))):
                 scene.add_wall(point, normal, material=s.wall_material, pair=s.wall_pair)

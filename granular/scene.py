@@ -167,6 +167,9 @@ class Scene:
         self.check_interval = int(check_interval)
         #: the most spheres found above the domain's top at one health check (launched grains; check_health)
         self.most_above_top = 0
+        #: the bin has no walls at its x ends (a moving soil patch holds spheres there instead): a sphere beyond
+        #: them is the owner's to remove, not an escape (check_health)
+        self.open_ends_x = False
         self.arch = runtime.init(arch)
 
         self.walls: list[Wall] = []
@@ -553,7 +556,7 @@ class Scene:
         device = self._to_device()
         p, out = device.particles, device.health
         lo, hi = self.domain_min.tolist(), self.domain_max.tolist()
-        if self.periodic_x:  # centres wrap at each rebuild; in between they may cross the ends
+        if self.periodic_x or self.open_ends_x:  # centres wrap at each rebuild; in between they may cross the ends
             lo[0], hi[0] = -math.inf, math.inf
         top, hi[2] = hi[2], math.inf
         integrator.state_health(p.x, p.v, p.w, p.m, p.I, lo, hi, top, out)

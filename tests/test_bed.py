@@ -209,3 +209,27 @@ def test_bed_spec_reads_back_as_written(periodic):
     those values, not as today's defaults (a walled bed read from the cache once came back periodic)."""
     spec = BedSpec(**{**TINY, "periodic": periodic})
     assert BedSpec.from_dict(spec.to_dict()) == spec
+
+
+def test_a_grain_thrown_over_an_open_end_of_a_moving_patch_leaves_the_soil(tmp_path):
+    """A moving patch's bin has no end walls (it holds the spheres there): a grain thrown over an end (launched from
+    under the wheel) is not an escape that stops the run but soil leaving the patch, as the rut behind the rear
+    end does at each shift; the patch removes it and counts it, its bookkeeping stays in step with the scene."""
+    from wheelsoil.coupling.patch import MovingPatch
+
+    bed = prepare_bed(BedSpec(**{**TINY, "periodic": True}), cache_dir=tmp_path)
+    scene = bed.to_scene(periodic_x=False, end_walls=False)
+    assert scene.open_ends_x
+    patch = MovingPatch(bed, wheel_reach=0.02, shift=0.01)
+    patch.start(scene)
+    n = scene.n_particles
+    free = np.flatnonzero(~scene.held)
+    top = int(free[np.argmax(scene.positions[free, 2])])  # a free surface grain, thrown up and back over the end
+    v = np.zeros((n, 3))
+    v[top] = (-2.0, 0.0, 3.0)
+    scene.set_velocities(v)
+    scene.step(int(round(0.1 / scene.time_step)))  # the health check passes while it flies beyond x = 0
+    assert scene.positions[top, 0] < 0.0
+    assert patch.drop_thrown_out(scene) == 1 and patch.thrown_out == 1
+    assert scene.n_particles == n - 1 == len(patch.ids) == len(patch.expected)
+    assert (scene.positions[:, 0] >= 0.0).all() and patch.drop_thrown_out(scene) == 0
