@@ -246,6 +246,8 @@ def run_sweep(sweep: Sweep, *, workers: int | None = None, scheduler: str | None
         mark = "[green]finished[/]" if result["status"] == "finished" else f"[red]failed[/]: {result.get('error')}"
         say(f"  {c.name}: {mark} ({result.get('wall_seconds', 0):.0f} s)")
         _write_status(sweep, status)
+        if result["status"] == "finished":  # the tables and figures follow each finished case: a sweep of hours
+            write_summary(sweep)            # killed half-way keeps what it has (summary.csv for validate --model)
         if bar is not None:
             bar.advance(task)
 

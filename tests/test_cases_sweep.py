@@ -110,3 +110,18 @@ def test_an_unreachable_scheduler_is_an_input_error(tmp_path, capsys):
     assert "cannot reach the dask scheduler" in capsys.readouterr().err
     assert main(["batch", str(path), "--out", str(tmp_path / "y"), "--scheduler", "tcp://127.0.0.1"]) == 2
     assert "not an address such as tcp://host:8786" in capsys.readouterr().err
+
+
+def test_the_summary_follows_each_finished_case(tmp_path, monkeypatch):
+    """A sweep of hours writes its tables after each finished case, not only at its end: one killed half-way keeps
+    a summary of what finished (what ``validate --model`` reads); a failed case writes none."""
+    import wheelsoil.cases.sweep as sweep_module
+
+    path = write(tmp_path, f'[sweep]\nbase = "mini-1g-steer"\n{COMMON}\n[sweep.grid]\n"test.slip" = [0.1, 0.2, 0.3]\n')
+    sweep = load_sweep(path, tmp_path / "out")
+    outcomes = iter([{"status": "finished"}, {"status": "failed", "error": "x"}, {"status": "finished"}])
+    monkeypatch.setattr(sweep_module, "execute_case", lambda *a, **k: next(outcomes))
+    calls = []
+    monkeypatch.setattr(sweep_module, "write_summary", lambda s: calls.append(s.name))
+    run_sweep(sweep, workers=1)
+    assert len(calls) == 3  # after the two finished cases, and once more at the end
