@@ -16,6 +16,7 @@ spanning every response's range of steering and slip).
 from __future__ import annotations
 
 import csv
+import math
 import sys
 from pathlib import Path
 
@@ -29,9 +30,29 @@ SUBSET_SLIPS = (-1.0, -0.5, 0.0, 0.5, 0.9)
 SUBSET_TRIAL = 1
 
 
+def drive_time(slip: float) -> float | None:
+    """The drive [s] a braked or dragged trial needs, or None for the preset's (6 s, enough driving).
+
+    The steady detector judges a run by pitches of the tread's rotation: one revolution first, then a window of at
+    least ``output.average_time`` checked twice half a revolution apart (the wheel's period), so about 3 pi / omega
+    of drive. Braking at travel slip i the hub turns at omega_0 (1 + i): at i = -0.5, 10.9 s of drive, against the
+    preset's 6 s, which left the first braking run of the subset short of one revolution. The dragged wheel does not
+    turn (its pitches are those of its travel) and was still sinking after 6 s: it gets twice the preset's drive."""
+    from .schema import load_case
+
+    test = load_case("cmu-grouser").test
+    if slip >= 0.0:
+        return None
+    if slip <= -1.0:
+        return 2.0 * test.drive_time
+    need = 3.0 * math.pi / (test.angular_velocity * (1.0 + slip)) + test.spin_up_time
+    return round(max(test.drive_time, need), 1) if need > test.drive_time else None
+
+
 def trial_rows(folder: str | Path) -> list[dict]:
     """One sweep row per measured trial: ``wheel.preset``, ``case.seed`` (the repeat at its condition), ``test.slip``,
-    ``test.slip_angle`` and ``test.load`` (the trial's measured mean load [N])."""
+    ``test.slip_angle`` and ``test.load`` (the trial's measured mean load [N]), and for a braked or dragged trial
+    ``test.drive_time`` (:func:`drive_time`)."""
     folder = Path(folder)
     rows = []
     for wheel, name in TRIAL_FILES.items():
@@ -49,6 +70,9 @@ def trial_rows(folder: str | Path) -> list[dict]:
                 rows.append({"wheel.preset": f"cmu-k10-{wheel}", "case.seed": repeats[condition],
                              "test.slip": float(row["slip"]), "test.slip_angle": float(row["steering_angle_deg"]),
                              "test.load": float(row["vertical_load_N"])})
+                drive = drive_time(float(row["slip"]))
+                if drive is not None:
+                    rows[-1]["test.drive_time"] = drive
     return rows
 
 
@@ -85,7 +109,8 @@ def write_presets(folder: str | Path, presets: str | Path | None = None) -> list
     rows = trial_rows(folder)
     common = ("Written by `python -m wheelsoil.cases.cmu_sweep ../shared/data/measured/cmu_3d_terramechanics`\n"
               "(wheelsoil.cases.cmu_sweep): one case per trial at its steering angle, slip and measured mean load;\n"
-              "its repeat at its condition is the bed's seed. Hours of CPU per case: use a GPU (wheelsoil batch --arch).")
+              "its repeat at its condition is the bed's seed. About 25 min a case on 2 cores, one at a time (--workers 1;\n"
+              "benchmarks/README.md); a GPU: wheelsoil batch --arch.")
     paths = []
     for name, chosen, what in (("cmu-trials", rows, f"The CMU single-wheel trials, all {len(rows)}, as DEM-FEM cases."),
                                ("cmu-trials-subset", subset(rows), "A subset of the CMU trials fixed before any "
