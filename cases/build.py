@@ -1,6 +1,6 @@
 """From a validated case to the solver's specs: the one place where case keys become solver inputs.
 
-A case (:class:`~wheelsoil.cases.schema.CaseFile`) says what a user asked for, section by section; the solver
+A case (:class:`~wheelsoil.cases.case_model.CaseFile`) says what a user asked for, section by section; the solver
 takes three specs, each of which checks its own ranges (:mod:`wheelsoil.ranges`) and defaults from the same
 parameter set (:mod:`wheelsoil.parameters.smoke`):
 
@@ -9,14 +9,13 @@ parameter set (:mod:`wheelsoil.parameters.smoke`):
 * :func:`testbed_spec` -- ``[test]``, ``[contact]``, ``[output]``, ``soil.time_step`` and the wheel's
   ``rigid``/``damping`` -> :class:`~wheelsoil.coupling.testbed.TestbedSpec`.
 
-The schema calls :func:`specs` when it validates a case, so the solver's cross-checks (particles against the
+The schema (:func:`~wheelsoil.cases.schema.validate_case`) calls :func:`specs` when it validates a case, so the solver's cross-checks (particles against the
 bin, the wheel against the bin, the drive against a static bin) run before any work.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 from wheelsoil.coupling.testbed import TestbedSpec
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, preset
@@ -24,8 +23,7 @@ from wheelsoil.granular.bed import BedSpec
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import seed004, smoke
 
-if TYPE_CHECKING:  # type hints only: the schema imports this module
-    from .schema import CaseFile
+from .case_model import CaseFile
 
 #: Wheel keys that replace the preset's value when given (None: keep the preset's).
 WHEEL_KEYS = ("element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
