@@ -199,9 +199,10 @@ def main(argv=None) -> int:
     plot_trials(data, {"lab's soil": preds["lab"], "fitted": preds["fitted"]}, out / "lab-vs-trials.png",
                 points=points)
     lines += ["", "![](lab-vs-trials.png)", ""]
-    if twin is not None:
-        findings_twin = {k: v for k, v in twin.items() if k not in ("responses", "std", "measured_rows")}
-    findings = {"twin": findings_twin if twin is not None else None, "unsupported": {m: int(u.sum()) for m, u in unsupported.items()}, "lab_soil": soil.to_dict(), "fitted_soil": fitted.to_dict(), "reece_fit": reece, "rms": rms,
+    twin_record = None if twin is None else {k: v for k, v in twin.items()
+                                             if k not in ("responses", "std", "measured_rows")}
+    findings = {"twin": twin_record, "unsupported": {m: int(u.sum()) for m, u in unsupported.items()},
+                "lab_soil": soil.to_dict(), "fitted_soil": fitted.to_dict(), "reece_fit": reece, "rms": rms,
                 "scales": scales, "residuals_by_group": groups, "provenance": provenance()}
     write_markdown_and_json(out / "README.md", "\n".join(lines), out / "findings.json", findings, default=float)
     print("\n".join(lines))
