@@ -16,6 +16,8 @@ and a measured extrapolation to seed-004 scale (388,026 particles, the full-reso
    measured at smoke scale, then 0.1 s settle, 0.05 s spin-up, 2.5 s drive).
 
 Run:  python -m wheelsoil.benchmarks.testbed_throughput [--out benchmarks/results/testbed.json] [--arch cuda]
+      python -m wheelsoil.benchmarks.testbed_throughput --cmu --out benchmarks/results/testbed-cmu.json
+        (only the CMU twin's scale: part 1 on ``cmu-grouser``)
       python -m wheelsoil.benchmarks.testbed_throughput --compare-pinning 3 --drive-time 0.05
         (only the A/B of pinned and unpinned worker threads, :mod:`wheelsoil.threads`, in alternating processes)
 """
@@ -54,14 +56,21 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
     setattr(obj, name, wrapper)
 
 
-def smoke_part(steps: int, drive_time: float, arch) -> dict:
+#: The coupled parts: name -> the case preset they run.
+COUPLED_PARTS = {"smoke": "smoke-1g-steer", "cmu": "cmu-grouser"}
+
+
+def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"]) -> dict:
+    """The whole protocol of ``preset`` with a short drive, then ``steps`` timed DEM steps of steady driving by part,
+    then the same bed alone (module docstring, part 1; ``preset`` cmu-grouser: the CMU twin's rigid wheel on its
+    calibrated sand, issue 37 item 2)."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed, soil_headroom
     from wheelsoil.granular import prepare_bed
 
-    case = load_case("smoke-1g-steer", [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
-                                        f"output.average_time={min(0.1, 0.5 * drive_time)!r}"])
+    case = load_case(preset, [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
+                              f"output.average_time={min(0.1, 0.5 * drive_time)!r}", "output.render=false"])
     bed = prepare_bed(build.bed_spec(case), arch=arch)
     t0 = time.perf_counter()
     bench = Testbed(bed, build.wheel_geometry(case), build.testbed_spec(case), arch=arch)
@@ -271,6 +280,25 @@ def compare_pinning(args) -> int:
     return 0
 
 
+def cmu_scale(args) -> int:
+    """The CMU twin's coupled step against its bed alone; prints and writes ``--out``."""
+    runtime.init(args.arch)
+    report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
+    cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"])
+    print(f"CMU scale ({cmu['case']}): {cmu['particles']} particles, rigid wheel of {cmu['fe_elements']} elements; "
+          f"{cmu['wall_seconds_per_simulated_second']:.0f} s wall per simulated s over the protocol; per DEM step "
+          f"{cmu['ms_per_step']:.2f} ms = soil {cmu['ms_per_step_soil']:.2f} + wheel {cmu['ms_per_step_wheel']:.2f} + "
+          f"contact {cmu['ms_per_step_contact_evaluation']:.2f} + rebuild {cmu['ms_per_step_contact_rebuild']:.2f} "
+          f"({cmu['cores_busy']:.2f} cores busy); the bed alone {cmu['ms_per_step_soil_alone']:.2f} ms "
+          f"({cmu['soil_alone_cores_busy']:.2f} cores): coupled / soil alone {cmu['coupled_over_soil_alone']:.2f} "
+          f"(goal <= 1.2); CPU per step {cmu['cpu_ms_per_step']:.2f} ms, the bed alone "
+          f"{cmu['cpu_ms_per_step_soil_alone']:.2f}; peak RSS {cmu['peak_rss_mib']:.0f} MiB", flush=True)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(report, indent=2, default=float))
+    print(f"wrote {args.out}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results/testbed.json"))
@@ -280,16 +308,22 @@ def main(argv=None) -> int:
     ap.add_argument("--compare-pinning", type=int, default=0, metavar="PAIRS",
                     help="only compare worker threads pinned and not (WHEELSOIL_PIN_THREADS): PAIRS alternating "
                          "pairs of processes, each timing --steps coupled steps and the soil alone at smoke scale")
-    ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke"), help=argparse.SUPPRESS)
+    ap.add_argument("--cmu", action="store_true",
+                    help="only the CMU twin's scale (cmu-grouser: rigid wheel, about 21,500 particles): the coupled "
+                         "step by part against the same bed alone (issue 37 item 2)")
+    ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.part:
         fn = {"fe-seed004": lambda: fe_seed004_part(min(args.steps, 200), args.arch),
               "dem-seed004": lambda: dem_seed004_part(args.arch), "base": lambda: base_part(args.arch),
-              "smoke": lambda: smoke_part(args.steps, args.drive_time, args.arch)}[args.part]
+              "smoke": lambda: smoke_part(args.steps, args.drive_time, args.arch),
+              "cmu": lambda: smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"])}[args.part]
         print(json.dumps(fn(), default=float))
         return 0
     if args.compare_pinning:
         return compare_pinning(args)
+    if args.cmu:
+        return cmu_scale(args)
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
     print("smoke scale: whole protocol, then timed steady driving ...", flush=True)
