@@ -46,7 +46,7 @@ def drive_time(slip: float) -> float | None:
     if slip <= -1.0:
         return 2.0 * test.drive_time
     need = 3.0 * math.pi / (test.angular_velocity * (1.0 + slip)) + test.spin_up_time
-    return round(max(test.drive_time, need), 1) if need > test.drive_time else None
+    return round(need, 1) if need > test.drive_time else None
 
 
 def trial_rows(folder: str | Path) -> list[dict]:
