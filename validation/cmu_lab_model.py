@@ -29,7 +29,8 @@ What it adds to wheelsoil's classical model (:mod:`.terramechanics`), each as it
 
 Inside, the signs are the lab's (``average_data_to_model.m``: drawbar pull forward, lateral force positive at
 positive steering, as the dataset's files hold them); :func:`predict_trials` returns the lateral force in
-wheelsoil's frame, negated as :func:`~.measured.load_cmu_file` negates the measured one. The lab's file ``j_t.m`` takes the rim radius r where the others take r_s
+wheelsoil's frame, negated as :func:`~.measured.load_cmu_file` negates the measured one.
+The lab's file ``j_t.m`` takes the rim radius r where the others take r_s
 (its condition r omega >= V and its displacement); kept as it is.
 """
 

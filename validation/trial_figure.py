@@ -25,7 +25,8 @@ class ModelPoints:
     std: dict = field(default_factory=dict)
 
 
-def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *, points: dict[str, ModelPoints] | None = None,
+def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *,
+                points: dict[str, ModelPoints] | None = None,
                 responses=RESPONSES) -> Path:
     """Write the figure to ``path``: ``lines`` maps a model's name to its predictions over every row (response ->
     array), ``points`` a model's name to its :class:`ModelPoints`. Slip on the x axis is the rig's (against the
