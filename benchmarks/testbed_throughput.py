@@ -280,6 +280,13 @@ def compare_pinning(args) -> int:
     return 0
 
 
+def _write_report(out: Path, report: dict) -> int:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(report, indent=2, default=float))
+    print(f"wrote {out}")
+    return 0
+
+
 def cmu_scale(args) -> int:
     """The CMU twin's coupled step against its bed alone; prints and writes ``--out``."""
     runtime.init(args.arch)
@@ -293,10 +300,7 @@ def cmu_scale(args) -> int:
           f"({cmu['soil_alone_cores_busy']:.2f} cores): coupled / soil alone {cmu['coupled_over_soil_alone']:.2f} "
           f"(goal <= 1.2); CPU per step {cmu['cpu_ms_per_step']:.2f} ms, the bed alone "
           f"{cmu['cpu_ms_per_step_soil_alone']:.2f}; peak RSS {cmu['peak_rss_mib']:.0f} MiB", flush=True)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(report, indent=2, default=float))
-    print(f"wrote {args.out}")
-    return 0
+    return _write_report(args.out, report)
 
 
 def main(argv=None) -> int:
@@ -360,10 +364,7 @@ def main(argv=None) -> int:
           f"{ext['wall_seconds_per_simulated_second'] / 3600:.2f} h wall per simulated s; one case "
           f"({ext['protocol_simulated_seconds']:.2f} s simulated) {ext['protocol_wall_hours']:.1f} h; "
           f"peak RSS {ext['peak_rss_mib']:.0f} MiB", flush=True)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(report, indent=2, default=float))
-    print(f"wrote {args.out}")
-    return 0
+    return _write_report(args.out, report)
 
 
 if __name__ == "__main__":
