@@ -44,6 +44,9 @@ def test_pairs_follow_the_conditions_and_an_offset_is_measured_exactly(tmp_path)
     for q in ("lateral_force", "torque", "sinkage"):
         assert c.responses[q]["rmse"] == pytest.approx(0.0, abs=1e-9)
     assert c.responses["torque"]["within_2sigma"] == 1.0
+    # normalised by the spread of every measured row, as the semi-empirical model is, not of the paired half only
+    assert c.responses["drawbar_pull"]["spread"] == pytest.approx(np.std(measured.responses["drawbar_pull"]), rel=1e-12)
+    assert c.responses["drawbar_pull"]["nbias"] == pytest.approx(7.0 / np.std(measured.responses["drawbar_pull"]))
 
 
 def test_a_simulation_missing_a_mechanism_shows_a_systematic_trend(tmp_path):

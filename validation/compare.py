@@ -6,7 +6,7 @@ Each measured row is paired with the simulated run at the same conditions -- sli
 gravity, pass number -- on the same wheel (radius, width, grouser height); rows without a partner are
 listed, not guessed. For each response the report gives the paired values, the residual simulated -
 measured, its size in combined standard deviations (the measured and the simulated scatter, where known),
-the bias and RMS error normalised by the measured spread, and the Spearman trend of the residual against
+the bias and RMS error normalised by the measured spread (over every measured row), and the Spearman trend of the residual against
 each condition that varies: the same diagnostics the semi-empirical model gets, so a systematic error of
 the simulation (e.g. growing with the steering angle) is named the same way.
 """
@@ -18,6 +18,7 @@ from scipy.stats import spearmanr
 
 from wheelsoil.errors import WheelsoilInputError
 
+from .calibration import response_scales
 from .measured import Measurements
 from .report import UNITS
 
@@ -91,8 +92,9 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
         if ok.sum() == 0:
             continue
         res = s[ok] - y[ok]
-        spread = float(np.std(y[ok])) if ok.sum() > 1 else 0.0
-        spread = spread if spread > 0 else max(float(np.max(np.abs(y[ok]))), 1e-12)
+        # the measured spread over every row of the data, not only the paired ones: a sweep that ran a few trials
+        # (one, even) is normalised as the semi-empirical model is
+        spread = response_scales(data, [q])[q]
         sd = np.zeros(ok.sum())
         for m, col in ((data, 0), (simulated, 1)):
             if q in m.std:
