@@ -30,17 +30,15 @@ SUBSET_SLIPS = (-1.0, -0.5, 0.0, 0.5, 0.9)
 SUBSET_TRIAL = 1
 
 
-def drive_time(slip: float) -> float | None:
+def drive_time(slip: float, test) -> float | None:
     """The drive [s] a braked or dragged trial needs, or None for the preset's (6 s, enough driving).
 
     The steady detector judges a run by pitches of the tread's rotation: one revolution first, then a window of at
     least ``output.average_time`` checked twice half a revolution apart (the wheel's period), so about 3 pi / omega
     of drive. Braking at travel slip i the hub turns at omega_0 (1 + i): at i = -0.5, 10.9 s of drive, against the
     preset's 6 s, which left the first braking run of the subset short of one revolution. The dragged wheel does not
-    turn (its pitches are those of its travel) and was still sinking after 6 s: it gets twice the preset's drive."""
-    from .schema import load_case
-
-    test = load_case("cmu-grouser").test
+    turn (its pitches are those of its travel) and was still sinking after 6 s: it gets twice the preset's drive.
+    ``test``: the ``[test]`` section of the sweeps' base preset (``cmu-grouser``)."""
     if slip >= 0.0:
         return None
     if slip <= -1.0:
@@ -53,7 +51,10 @@ def trial_rows(folder: str | Path) -> list[dict]:
     """One sweep row per measured trial: ``wheel.preset``, ``case.seed`` (the repeat at its condition), ``test.slip``,
     ``test.slip_angle`` and ``test.load`` (the trial's measured mean load [N]), and for a braked or dragged trial
     ``test.drive_time`` (:func:`drive_time`)."""
+    from .schema import load_case
+
     folder = Path(folder)
+    base = load_case("cmu-grouser").test  # the sweeps' base, read once
     rows = []
     for wheel, name in TRIAL_FILES.items():
         path = folder / name
@@ -70,7 +71,7 @@ def trial_rows(folder: str | Path) -> list[dict]:
                 rows.append({"wheel.preset": f"cmu-k10-{wheel}", "case.seed": repeats[condition],
                              "test.slip": float(row["slip"]), "test.slip_angle": float(row["steering_angle_deg"]),
                              "test.load": float(row["vertical_load_N"])})
-                drive = drive_time(float(row["slip"]))
+                drive = drive_time(float(row["slip"]), base)
                 if drive is not None:
                     rows[-1]["test.drive_time"] = drive
     return rows
