@@ -93,12 +93,12 @@ def _unsupported(soil, data) -> np.ndarray:
 def three_models(data, preds: dict, scales: dict, sweep: str) -> tuple[dict, list[str]]:
     """The DEM--FEM twin's steady runs of ``sweep`` paired with the measured rows, and the three models' bias and
     RMS error on those rows (normalised by the responses' measured spread), as Markdown lines."""
-    from wheelsoil.validation.compare import match_conditions
+    from wheelsoil.validation.compare import compare
     from wheelsoil.validation.measured import load_sweep_summary
 
     simulated = load_sweep_summary(sweep)
-    pairs, _ = match_conditions(data, simulated)
-    rows, runs = pairs[:, 0], pairs[:, 1]
+    paired = compare(data, simulated, RESPONSES)  # the pairs and the twin's share within two combined std
+    rows, runs = paired.pairs[:, 0], paired.pairs[:, 1]
     twin = {"sweep": str(sweep), "notes": simulated.notes, "paired": int(len(rows)), "measured_rows": rows,
             "responses": {q: simulated.responses[q][runs] for q in RESPONSES},
             "std": {q: simulated.std[q][runs] for q in RESPONSES}}
@@ -111,16 +111,16 @@ def three_models(data, preds: dict, scales: dict, sweep: str) -> tuple[dict, lis
     scores = {}
     for q in RESPONSES:
         measured = data.responses[q][rows]
-        sigma = np.hypot(data.std[q][rows], twin["std"][q]) if q in data.std else twin["std"][q]
         row = {}
         for name, values in (("twin", twin["responses"][q]), ("lab", preds["lab"][q][rows]),
                              ("fitted", preds["fitted"][q][rows])):
             r = (values - measured) / scales[q]
             row[name] = {"bias": float(np.mean(r)), "rms": float(np.sqrt(np.mean(r ** 2)))}
-        row["twin"]["within_2sigma"] = float(np.mean(np.abs(twin["responses"][q] - measured) <= 2 * sigma))
+        within = row["twin"]["within_2sigma"] = paired.responses[q]["within_2sigma"]
         scores[q] = row
         lines.append(f"| {q} | {row['twin']['bias']:+.3f} / {row['twin']['rms']:.3f} "
-                     f"({row['twin']['within_2sigma']:.0%}) | {row['lab']['bias']:+.3f} / {row['lab']['rms']:.3f} | "
+                     f"({'–' if within is None else f'{within:.0%}'}) | "
+                     f"{row['lab']['bias']:+.3f} / {row['lab']['rms']:.3f} | "
                      f"{row['fitted']['bias']:+.3f} / {row['fitted']['rms']:.3f} |")
     twin["scores"] = scores
     twin["trials"] = [{"wheel": str(data.group[k]), "slip_angle": float(data.slip_angle[k]),
