@@ -134,6 +134,8 @@ def test_a_run_without_a_steady_state_is_left_out_and_named(tmp_path):
     kept = load_sweep_summary(tmp_path / "sweep")
     assert len(kept) == len(sim) - 1 and "1 not steady, left out: case-3" in kept.notes
     np.testing.assert_array_equal(kept.slip, np.delete(sim.slip, 3))
+    table.drop(columns="case").to_csv(tmp_path / "sweep" / "summary.csv", index=False)  # no names: rows are named
+    assert "left out: row 3" in load_sweep_summary(tmp_path / "sweep").notes
     table["steady"] = False
     table.to_csv(tmp_path / "sweep" / "summary.csv", index=False)
     with pytest.raises(WheelsoilInputError, match="none of its 18 runs reached a steady state"):

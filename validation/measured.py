@@ -376,7 +376,8 @@ def load_sweep_summary(path: str | Path) -> Measurements:
     not_steady = []
     if "steady" in t.columns:
         steady = t["steady"].astype(str).str.lower().isin(("true", "1", "1.0"))
-        not_steady = [str(v) for v in t.loc[~steady, "case"]] if "case" in t.columns else [""] * int((~steady).sum())
+        names = t["case"] if "case" in t.columns else "row " + t.index.astype(str)
+        not_steady = [str(v) for v in names[~steady]]
         t = t.loc[steady].reset_index(drop=True)
         if t.empty:
             raise WheelsoilInputError(f"{path}: none of its {len(not_steady)} runs reached a steady state; there is "

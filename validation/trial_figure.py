@@ -57,9 +57,9 @@ def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *,
                 for name, p in (points or {}).items():
                     hit = m[p.rows]
                     if hit.any():
-                        ax.errorbar(slip[p.rows[hit]], p.responses[q][hit], yerr=p.std.get(q, None)[hit]
-                                    if q in p.std else None, fmt="s", ms=5, mfc="none", color=colour, capsize=1.5,
-                                    label=f"{wheel}, {name}")
+                        ax.errorbar(slip[p.rows[hit]], p.responses[q][hit],
+                                    yerr=p.std[q][hit] if q in p.std else None, fmt="s", ms=5, mfc="none",
+                                    color=colour, capsize=1.5, label=f"{wheel}, {name}")
             ax.set_title(f"{beta:g}°", fontsize=9)
             if row == len(responses) - 1:
                 ax.set_xlabel("slip (rig's)")
