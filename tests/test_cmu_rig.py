@@ -127,3 +127,30 @@ def test_the_rig_runs_on_the_calibrated_sand(preset):
     assert (soil.density, soil.youngs_modulus, soil.poisson_ratio) == (
         material.density, material.youngs_modulus, material.poisson_ratio)
     assert (soil.diameter_min, soil.diameter_max) == pytest.approx(cmu_sand.TWIN_DIAMETERS)
+
+
+def test_a_candidate_sweep_changes_the_soil_only_and_runs_subset_trials():
+    """A DEM-side candidate (issue 34 item 3) is the twin with its soil changed: every candidate case is a subset case
+    (same wheel, rig and trial) on the candidate's particles, and the replicas are the same trial's other seeds."""
+    from wheelsoil.cases.cmu_sweep import CANDIDATES
+    from wheelsoil.cases.sweep import load_sweep
+    from wheelsoil.parameters import cmu_sand
+
+    subset = {(c.case.wheel.model_dump_json(), c.case.test.model_dump_json(), c.case.case.seed): c.case
+              for c in load_sweep("cmu-trials-subset").cases}
+    for name in CANDIDATES:
+        cases = load_sweep(f"cmu-candidate-{name}").cases
+        assert {c.case.test.slip_angle for c in cases} == {0.0, 45.0, 90.0}
+        for c in cases:
+            twin = subset[(c.case.wheel.model_dump_json(), c.case.test.model_dump_json(), c.case.case.seed)]
+            changed = {k for k, v in c.case.soil.model_dump().items() if twin.soil.model_dump()[k] != v}
+            assert changed == {"static_friction", "rolling_friction", "density"}
+            assert (c.case.soil.static_friction, c.case.soil.rolling_friction, c.case.soil.density) == (
+                cmu_sand.PLATE_FIT_PAIR.static_friction, cmu_sand.PLATE_FIT_PAIR.rolling_friction,
+                cmu_sand.PLATE_FIT_MATERIAL.density)
+    replicas = load_sweep("cmu-replicas").cases
+    first = [c for c in load_sweep("cmu-trials-subset").cases
+             if (c.case.test.slip_angle, round(c.case.test.slip, 1), c.case.wheel.preset) == (0.0, 0.5, "cmu-k10-grouser")]
+    assert len(first) == 1 and len(replicas) >= 2
+    assert {c.case.case.seed for c in replicas}.isdisjoint({first[0].case.case.seed})
+    assert all(c.case.soil == first[0].case.soil and c.case.wheel == first[0].case.wheel for c in replicas)

@@ -42,3 +42,19 @@ CALIBRATION = {
     "plate_log_mse": 0.591, "objective": 0.759,
     "candidate": "docs/soillab/calibration-epsd-surface/candidates/mu0.52_mur0.5_epsd.json",
 }
+
+# ---------------------------------------------------------------- the twin's first DEM-side candidate (issue 34)
+#: The particles calibrated on the sand's plates alone: the EPSD grid's candidate with the least plate error
+#: (log-MSE 0.19 against the chosen soil's 0.59), sliding 0.5 and rolling 0.1, whose repose (21.6 deg) the chosen
+#: soil's objective rejected. Its shear box peaks at 39.0 deg with 0.94 kPa of apparent cohesion against the chosen
+#: soil's 45.4 deg and 2.9 kPa, so it is the lab-calibrated soil with the weaker shear strength: the CMU twin's
+#: candidate for its drawbar pull four times the trial's (docs/cmu-twin/README.md, fixed before its runs).
+PLATE_FIT_PAIR = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.1, rolling_model="epsd")
+#: Its particle density: the one whose poured bed (packing fraction 0.569) has the sand's bulk density.
+PLATE_FIT_MATERIAL = Material("cmu sand (plates alone)", youngs_modulus=50e6, poisson_ratio=0.3, density=2340.0)
+#: What the lab measured on it (seed 0), for reports.
+PLATE_FIT_CALIBRATION = {
+    "packing_fraction": 0.569, "bulk_density": 1331.3, "repose_deg": 21.6, "shear_peak_angle_deg": 39.0,
+    "shear_peak_cohesion_Pa": 942.0, "plate_log_mse": 0.188, "objective": 13.9,
+    "candidate": "docs/soillab/calibration-epsd/candidates/mu0.5_mur0.1_epsd.json",
+}
