@@ -9,8 +9,13 @@ DEM step costs, and what that interval takes on this machine.
 Also the compile time of the smoke wheel's stepping kernel (two sub-steps a launch, as a coupled smoke run
 takes them) in a fresh process with an empty Taichi kernel cache, then with the cache it filled.
 
+With ``--cmu-rigid``: only the CMU twin's rigid grousered wheel (the ``cmu-grouser`` preset, its hub free and
+spinning under random nodal loads), one step at the twin's DEM step in the serial and the parallel form, in
+alternating rounds (a shared machine's speed drifts between rounds); the two forms' states are compared bit for bit.
+
 Run:  python -m wheelsoil.benchmarks.wheel_throughput [--out benchmarks/results/wheel.json]
       python -m wheelsoil.benchmarks.wheel_throughput --compile-only
+      python -m wheelsoil.benchmarks.wheel_throughput --cmu-rigid [--out benchmarks/results/wheel-cmu-rigid.json]
 """
 
 import argparse
@@ -59,6 +64,50 @@ def compile_time_cold_wheel(arch=None) -> dict:
     return cache_times(_COMPILE_CODE.format(arch=arch), ("setup_s", "first_two_substeps_s", "next_two_substeps_s"))
 
 
+def cmu_rigid_forms(steps: int, rounds: int) -> dict:
+    """The CMU rigid wheel's step [s] in the serial and parallel forms, alternating rounds (module docstring)."""
+    import numpy as np
+
+    from wheelsoil.cases.build import wheel_geometry
+    from wheelsoil.cases.schema import load_case
+    from wheelsoil.flexwheel.geometry import build_wheel_mesh
+    from wheelsoil.flexwheel.structure import Structure
+
+    case = load_case("cmu-grouser")
+    geometry = wheel_geometry(case)
+    dt = 2e-5  # the twin's DEM step (its runs' logs)
+    mesh, hub = build_wheel_mesh(geometry)
+    rng = np.random.default_rng(0)
+    forces, moments = rng.normal(size=(mesh.n_nodes, 3)), 1e-3 * rng.normal(size=(mesh.n_nodes, 3))
+
+    def wheel(serial: bool):
+        w = Structure(mesh, hub_nodes=hub, hub_center=np.zeros(3), hub_mass=geometry.hub_mass, rigid=True,
+                      damping=case.wheel.damping, serial=serial)
+        w.set_external(forces, moments)
+        w.drive_hub(free_translation=(True, True, True), free_rotation=(True, True, True),
+                    angular_velocity=(0.0, case.test.angular_velocity, 0.0))
+        w.advance(dt)  # compile and warm up
+        return w
+
+    times: dict = {"serial": [], "parallel": []}
+    final = {}
+    for _ in range(rounds):
+        for form in times:
+            w = wheel(form == "serial")
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                w.advance(dt, check=False)
+            w.check_health()  # ends on a host read: every launch has finished
+            times[form].append((time.perf_counter() - t0) / steps)
+            final[form] = w.positions()
+    same = bool(np.array_equal(final["serial"], final["parallel"]))
+    out = {"nodes": mesh.n_nodes, "elements": mesh.n_elements, "steps": steps, "rounds": rounds, "dt_s": dt,
+           "seconds_per_step": times, "same_state": same,
+           "parallel_over_serial_best": min(times["parallel"]) / min(times["serial"]),
+           "parallel_over_serial_rounds": [p / q for p, q in zip(times["parallel"], times["serial"])]}
+    return out
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("benchmarks/results/wheel.json"))
@@ -66,7 +115,22 @@ def main(argv=None) -> int:
     parser.add_argument("--arch", default=None, help="Taichi backend (default cpu)")
     parser.add_argument("--compile-only", action="store_true",
                         help="only the smoke wheel's stepping-kernel compile time, cold and warm cache")
+    parser.add_argument("--cmu-rigid", action="store_true",
+                        help="only the CMU twin's rigid wheel, serial against parallel form, alternating rounds")
+    parser.add_argument("--rounds", type=int, default=5, help="alternating rounds of --cmu-rigid (default 5)")
     args = parser.parse_args(argv)
+    if args.cmu_rigid:
+        runtime.init(args.arch)
+        res = {"machine": machine(), "versions": versions(), **cmu_rigid_forms(max(args.steps, 1000), args.rounds)}
+        best = {k: 1e3 * min(v) for k, v in res["seconds_per_step"].items()}
+        print(f"CMU rigid wheel, {res['nodes']} nodes: serial {best['serial']:.3f} ms/step, parallel "
+              f"{best['parallel']:.3f} ms/step (best of {args.rounds}); parallel/serial best "
+              f"{res['parallel_over_serial_best']:.2f}, per round "
+              f"{', '.join(f'{r:.2f}' for r in res['parallel_over_serial_rounds'])}; same state: {res['same_state']}")
+        out = args.out if args.out != Path("benchmarks/results/wheel.json") else Path("benchmarks/results/wheel-cmu-rigid.json")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(res, indent=2))
+        return 0
     if args.compile_only:
         compile_times = compile_time_cold_wheel(args.arch)
         print("smoke wheel, first two sub-steps:", json.dumps(compile_times))
