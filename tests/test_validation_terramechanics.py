@@ -276,13 +276,13 @@ def test_gravity_soil_flow_is_the_soil_flow_of_seed000_eq8_at_each_gravity():
                                               ("friction_angle", "load"), ("shear_modulus_x", "load")])
 def test_a_drift_is_the_soil_of_each_condition_with_its_own_parameter(field, condition):
     """A drift p max(1 + rate u, floor) is exactly the model run condition by condition with p set to that value (u = |i|,
-    sin|beta|, 1 - g / 9.81, n_p - 1, W / W_ref - 1); rate 0 is the soil without a drift, bit for bit. On the
+    sin|beta|, 1 - g / 9.81, n_p - 1, ln(W / W_ref)); rate 0 is the soil without a drift, bit for bit. On the
     classical model: the sidewall, bulldozing and grouser terms keep the soil's own value (documented)."""
     soil = replace(SAND, **BASELINE_OFF)
     cond = dict(slip=np.array([0.05, 0.3, 0.6]), slip_angle=np.array([0.0, 10.0, 25.0]), load=np.array([40.0, 60.0, 120.0]),
                 gravity=np.array([9.81, 3.71, 1.62]), passes=np.array([1.0, 2.0, 3.0]))
     u = {"slip": np.abs(cond["slip"]), "slip_angle": np.sin(np.radians(cond["slip_angle"])),
-         "gravity": 1.0 - cond["gravity"] / 9.81, "passes": cond["passes"] - 1.0, "load": cond["load"] / 80.0 - 1.0}[condition]
+         "gravity": 1.0 - cond["gravity"] / 9.81, "passes": cond["passes"] - 1.0, "load": np.log(cond["load"] / 80.0)}[condition]
     rate = -0.6
     drifted = predict(replace(soil, drift_field=field, drift_condition=condition, drift_rate=rate, drift_reference=80.0),
                       WHEEL, **cond)

@@ -74,17 +74,20 @@ SHEAR_FORMS = ("independent", "resultant")
 #: keep the soil's own value.
 DRIFT_FIELDS = ("cohesion", "friction_angle", "shear_modulus_x", "kc_prime", "kphi_prime", "n0", "a1")
 #: The measure u of each condition a drift is linear in, u = 0 at the reference state: |slip|, sin|slip angle|,
-#: the fall in gravity 1 - g / 9.81, the earlier passes n_p - 1, and for the load and the wheel's radius and width
-#: the relative change x / x_ref - 1 from the reference ``SoilParameters.drift_reference`` (the discovery workflow
-#: takes the training rows' median). Each reads a dict of the conditions (:func:`drift_conditions`).
+#: the fall in gravity 1 - g / 9.81, the earlier passes n_p - 1, and for the load and the wheel's radius and width,
+#: conditions of scale, the log ratio ln(x / x_ref) to the reference ``SoilParameters.drift_reference`` (the discovery
+#: workflow takes the training rows' median): p (1 + rate ln(x / x_ref)) is a power law p (x / x_ref)^rate to first
+#: order, the form soil properties take with the scale of a test (Bekker's exponent; until 2026-11-27 the measure was
+#: x / x_ref - 1, docs/validation/campaigns.md says why it changed). Each reads a dict of the conditions
+#: (:func:`drift_conditions`).
 DRIFT_MEASURES = {
     "slip": lambda c: np.abs(c["slip"]),
     "slip_angle": lambda c: np.abs(np.sin(c["beta"])),
     "gravity": lambda c: 1.0 - c["gravity"] / EARTH_GRAVITY,
     "passes": lambda c: c["passes"] - 1.0,
-    "load": lambda c: c["load"] / c["reference"] - 1.0,
-    "radius": lambda c: c["radius"] / c["reference"] - 1.0,
-    "width": lambda c: c["width"] / c["reference"] - 1.0,
+    "load": lambda c: np.log(c["load"] / c["reference"]),
+    "radius": lambda c: np.log(c["radius"] / c["reference"]),
+    "width": lambda c: np.log(c["width"] / c["reference"]),
 }
 #: The conditions whose drift is measured from a reference value (:data:`DRIFT_MEASURES`).
 RELATIVE_DRIFTS = ("load", "radius", "width")
