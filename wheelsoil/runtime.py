@@ -14,7 +14,7 @@ from pathlib import Path
 
 import taichi as ti
 
-from . import threads
+from . import ndarray_release, threads
 from .errors import WheelsoilInputError
 
 _ARCHES = {
@@ -74,6 +74,7 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
     if cpu_threads is not None:
         kwargs["cpu_max_num_threads"] = int(cpu_threads)
     t0 = time.perf_counter()
+    ndarray_release.install()  # vector and matrix ndarrays free their memory when dropped (Taichi 1.7's leak)
     ti.init(**kwargs)
     actual = ti.lang.impl.current_cfg().arch
     if requested != "cpu" and actual in (ti.x64, ti.arm64):
