@@ -211,3 +211,12 @@ def test_a_linearised_load_on_a_moving_wheel_delivers_its_evaluated_impulse(lead
     else:
         assert impulse[2] == pytest.approx(expected + bias, rel=0.02)
     assert abs(impulse[0]) < 1e-9 * expected and abs(impulse[1]) < 1e-9 * expected
+
+
+@pytest.mark.parametrize("args, key", [(["--points", "1"], "--points=1"), (["--max-load-factor", "0"], "--max-load-factor=0"),
+                                       (["--max-twist", "50"], "--max-twist=50")])
+def test_wheel_command_checks_its_options_before_any_test(tmp_path, capsys, args, key):
+    """A bad load-test setting is refused before the wheel is meshed (nothing is written), the torsion's included."""
+    out = tmp_path / "w"
+    assert main(["wheel", "exomars", "--out", str(out), *args]) == 2
+    assert key in capsys.readouterr().err and not out.exists()

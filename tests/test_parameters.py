@@ -14,7 +14,7 @@ import pytest
 
 from wheelsoil.cases import build
 from wheelsoil.cases.cli import build_parser
-from wheelsoil.cases.cli import _spec_from_args as cli_bed_spec
+from wheelsoil.cases.commands.prepare_bed import spec_from_args as cli_bed_spec
 from wheelsoil.cases.schema import SECTIONS, CaseError, CaseFile, validate_case
 from wheelsoil.coupling.testbed import TestbedSpec
 from wheelsoil.errors import WheelsoilInputError

@@ -19,7 +19,8 @@ from wheelsoil.gravity import GRAVITY_PRESETS
 from wheelsoil.material import PairProperties
 from wheelsoil.parameters import soil_lab
 
-from .units import gravity_argument
+from ..units import gravity_argument
+from . import common
 
 TESTS = ("poured", "repose", "shear", "plate", "wheel")
 
@@ -69,7 +70,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--out", type=Path, default=Path("wheelsoil-output/soil-lab"), help="output folder")
     parser.add_argument("--cache", type=Path, default=None, help="bed cache folder (default the user cache)")
     parser.add_argument("--progress", action="store_true", help="progress bars on the terminal")
-    parser.add_argument("--arch", default=None, help="Taichi backend: cpu (default), cuda, vulkan, metal")
+    common.add_arch_option(parser)
     parser.set_defaults(func=run)
 
 

@@ -10,7 +10,7 @@ from rich.console import Console
 from wheelsoil.errors import WheelsoilInputError
 
 
-def add_parsers(sub) -> None:
+def add_parser(sub) -> None:
     """The ``validate`` and ``predict`` subcommands on ``sub`` (argparse subparsers)."""
     p = sub.add_parser("validate", help="hold the semi-empirical model against measured data; name what it misses",
                        description="Calibrate the classical wheel-soil model (Wong-Reece, Janosi-Hanamoto, lateral "
@@ -126,7 +126,7 @@ def run_validate(args) -> int:
     if args.periodic:
         from wheelsoil.validation.periodic import periodic_report
 
-        from .results import load_result
+        from ..results import load_result
 
         command = "wheelsoil " + " ".join(args.argv)
         folder = Path(args.data)
