@@ -138,16 +138,21 @@ def test_a_candidate_sweep_changes_the_soil_only_and_runs_subset_trials():
 
     subset = {(c.case.wheel.model_dump_json(), c.case.test.model_dump_json(), c.case.case.seed): c.case
               for c in load_sweep("cmu-trials-subset").cases}
-    for name in CANDIDATES:
+    for name, (overrides, _) in CANDIDATES.items():
         cases = load_sweep(f"cmu-candidate-{name}").cases
         assert {c.case.test.slip_angle for c in cases} == {0.0, 45.0, 90.0}
         for c in cases:
             twin = subset[(c.case.wheel.model_dump_json(), c.case.test.model_dump_json(), c.case.case.seed)]
             changed = {k for k, v in c.case.soil.model_dump().items() if twin.soil.model_dump()[k] != v}
-            assert changed == {"static_friction", "rolling_friction", "density"}
-            assert (c.case.soil.static_friction, c.case.soil.rolling_friction, c.case.soil.density) == (
-                cmu_sand.PLATE_FIT_PAIR.static_friction, cmu_sand.PLATE_FIT_PAIR.rolling_friction,
-                cmu_sand.PLATE_FIT_MATERIAL.density)
+            assert changed == {k.split(".")[1] for k in overrides}, name
+            assert all(getattr(c.case.soil, k.split(".")[1]) == v for k, v in overrides.items()), name
+    plate = CANDIDATES["plate-soil"][0]
+    assert (plate["soil.static_friction"], plate["soil.rolling_friction"], plate["soil.density"]) == (
+        cmu_sand.PLATE_FIT_PAIR.static_friction, cmu_sand.PLATE_FIT_PAIR.rolling_friction,
+        cmu_sand.PLATE_FIT_MATERIAL.density)
+    scale = CANDIDATES["particle-scale"][0]
+    assert (scale["soil.diameter_min"], scale["soil.diameter_max"]) == pytest.approx(
+        tuple(0.8 * d for d in cmu_sand.TWIN_DIAMETERS), rel=1e-9)
     replicas = load_sweep("cmu-replicas").cases
     first = [c for c in load_sweep("cmu-trials-subset").cases
              if (c.case.test.slip_angle, round(c.case.test.slip, 1), c.case.wheel.preset) == (0.0, 0.5, "cmu-k10-grouser")]
