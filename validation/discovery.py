@@ -44,7 +44,7 @@ residual remains is reported as a **partial** explanation, not named as the caus
 mechanism does not hold. Residuals are normalised per response by the training data's spread.
 """
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from itertools import combinations
 
 import numpy as np
@@ -64,35 +64,14 @@ from .extensions import (BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, dri
                          varied_conditions)
 from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
+from .selection import (AMBIGUITY_MARGIN, BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, PAIR_POOL, RIVAL_MARGIN, Candidate,
+                        Discovery, Step)
 from .terramechanics import SoilParameters
 
 __all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "PAIR_POOL", "RESPONSES",
            "RIVAL_MARGIN", "Candidate",
            "Discovery", "Fit", "Step", "discover", "holdout_mask", "mechanism_effect", "model_responses",
            "normalised_residuals", "response_scales"]
-
-BIC_MARGIN = 10.0
-#: The held-out check guards against a fit that predicts worse than the model it extends; the evidence is BIC's.
-#: The held-out set is a third of the rows, so its bootstrap spread is wide: one standard deviation.
-GAIN_SIGMAS = 1.0
-#: When no single mechanism passes and a systematic residual remains, pairs among this many best single fits
-#: (by BIC) are fitted together: two mechanisms that act together can each fail alone (a forward-selection
-#: look-ahead of one step).
-PAIR_POOL = 6
-AMBIGUITY_MARGIN = 10.0
-#: A generic rival (a classical parameter drifting with a condition the data vary) withholds the
-#: mechanism's name when the data prefer it: its BIC lower than the mechanism's by more than this, the smallest
-#: difference Kass & Raftery (1995) grade as evidence ("positive"; below 2 "not worth more than a bare mention").
-#: Not :data:`AMBIGUITY_MARGIN`, which is for two mechanisms of equal standing: a drift names no physics, so a tie
-#: goes to the mechanism, whose name then carries the rival beside it. (docs/validation/campaigns.md: with the
-#: symmetric margin of 10, hidden gravity mechanisms lost their names in 5 of 44 draws to drifts that fit worse
-#: by 3-10; with 0, to drifts that fit better by 0.5-0.8.)
-RIVAL_MARGIN = 2.0
-#: Share of the current model's systematic residual an accepted mechanism must remove.
-MIN_EXPLAINED = 0.5
-#: A mechanism "moves" a response when its effect's RMS there is at least this share of the response's spread.
-MOVES_RESPONSE = 0.05
-
 
 def holdout_mask(data: Measurements, *, fraction: float = 0.3, by: str | None = None, level=None,
                  seed: int = 0) -> np.ndarray:
@@ -153,187 +132,6 @@ def _parameter_problems(exts: Extension | tuple[Extension, ...], fit: Fit) -> li
     return problems
 
 
-@dataclass
-class Candidate:
-    """A mechanism tested at one selection step: its fit added to the current model, the evidence and checks."""
-
-    extension: Extension
-    step: int
-    fit: Fit
-    heldout_rmse: float
-    gain: float  # current model's held-out RMSE - this fit's (normalised units)
-    gain_std: float
-    delta_bic: float  # against the current model
-    effect: float  # RMS of the normalised responses the mechanism adds to the fitted model
-    explained: float  # share of the current model's systematic residual this fit removes
-    problems: list[str] = field(default_factory=list)  # parameter at a bound / opposite sign
-    accepted: bool = False
-    effect_by_response: dict = field(default_factory=dict)
-    #: accepted by the selection, but the final model still leaves a systematic residual in a response this
-    #: mechanism moves: it explains part of the misfit and is not named as its cause
-    partial: list[str] = field(default_factory=list)
-    #: a pair step (:data:`PAIR_POOL`): the second mechanism fitted together with ``extension``
-    partner: Extension | None = None
-    #: a pair's BIC against each member alone, by the member it adds ({b: joint - (current + a)}): each must
-    #: lower BIC by :data:`BIC_MARGIN`, or the pair holds a passenger
-    needs: dict = field(default_factory=dict)
-
-    @property
-    def extensions(self) -> tuple[Extension, ...]:
-        return (self.extension,) if self.partner is None else (self.extension, self.partner)
-
-    @property
-    def names(self) -> list[str]:
-        return [e.name for e in self.extensions]
-
-    @property
-    def name(self) -> str:
-        return " + ".join(self.names)
-
-    def moves(self) -> list[str]:
-        """The responses this mechanism changes by at least :data:`MOVES_RESPONSE` of their spread."""
-        return [q for q, v in self.effect_by_response.items() if v >= MOVES_RESPONSE]
-
-    @property
-    def checks(self) -> dict[str, bool]:
-        return {"evidence": bool(self.delta_bic < -BIC_MARGIN and all(v < -BIC_MARGIN for v in self.needs.values())),
-                "prediction": bool(self.gain > 0 and self.gain > GAIN_SIGMAS * self.gain_std),
-                "physical_parameter": not self.problems,
-                "signature": bool(self.explained >= MIN_EXPLAINED)}
-
-    @property
-    def passes(self) -> bool:
-        return all(self.checks.values())
-
-    def reasons(self) -> list[str]:
-        """Why it did not pass (empty when it did)."""
-        c, out = self.checks, []
-        if not c["evidence"]:
-            out.append(f"ΔBIC {self.delta_bic:+.1f} (needs < -{BIC_MARGIN:g})")
-            out += [f"{n} adds ΔBIC {v:+.1f} to the other alone" for n, v in self.needs.items() if v >= -BIC_MARGIN]
-        if not c["prediction"]:
-            out.append(f"held-out gain {self.gain:+.4f} ± {self.gain_std:.4f}")
-        out += self.problems
-        if not c["signature"]:
-            out.append(f"removes {100 * self.explained:.0f} % of the systematic residual (needs "
-                       f"{100 * MIN_EXPLAINED:.0f} %)")
-        return out
-
-    def parameters(self) -> dict[str, float]:
-        return {p.name: self.fit.free[p.name] for e in self.extensions for p in e.parameters}
-
-    def to_dict(self) -> dict:
-        table = {r["name"]: r for r in self.fit.parameter_table()}
-        return {"name": self.name, "names": self.names,
-                "mechanism": "; ".join(e.mechanism for e in self.extensions),
-                "source": "; ".join(e.source for e in self.extensions), "step": self.step,
-                "parameters": {p.name: {"value": table[p.name]["value"], "std_error": table[p.name]["std_error"],
-                                        "unit": p.unit, "at_bound": table[p.name]["at_bound"]}
-                               for e in self.extensions for p in e.parameters},
-                "needs": self.needs,
-                "train_rmse": self.fit.rmse, "heldout_rmse": self.heldout_rmse, "gain": self.gain,
-                "gain_std": self.gain_std, "delta_bic": self.delta_bic, "effect": self.effect,
-                "explained": self.explained, "checks": self.checks, "passes": self.passes,
-                "accepted": bool(self.accepted), "named": bool(self.accepted and not self.partial),
-                "moves": self.moves(), "partial_because": self.partial, "why_not": self.reasons()}
-
-
-@dataclass
-class Step:
-    """One round of forward selection: the model it started from and every candidate tried on it."""
-
-    index: int
-    model: tuple[str, ...]
-    heldout_rmse: float
-    systematic: float
-    candidates: list[Candidate]
-    accepted: str | None = None
-    ambiguity: list[str] = field(default_factory=list)
-    #: a look-ahead step: its candidates are pairs of mechanisms fitted together
-    pairs: bool = False
-    #: the generic drifts fitted in place of the best passing mechanism (:func:`_drift_rivals`), best first
-    rivals: list[dict] = field(default_factory=list)
-
-    def to_dict(self) -> dict:
-        return {"step": self.index, "model": list(self.model), "heldout_rmse": self.heldout_rmse,
-                "systematic_residual": self.systematic, "accepted": self.accepted, "ambiguity": self.ambiguity,
-                "pairs": self.pairs, "rivals": self.rivals,
-                "candidates": [c.to_dict() for c in self.candidates]}
-
-
-@dataclass
-class Discovery:
-    """What the workflow found: the calibrated baseline, each selection step, the accepted mechanisms, any
-    ambiguity, and what the final model leaves unexplained."""
-
-    baseline: Fit
-    baseline_heldout_rmse: float
-    steps: list[Step]
-    final: Fit
-    final_heldout_rmse: float
-    trends: list[dict]  # the baseline's residual trends (training rows)
-    lack_of_fit: dict  # {"baseline": ..., "final": ...}
-    unexplained: list[dict]
-    responses: tuple
-    scales: dict
-    n_train: int
-    n_heldout: int
-    skipped: dict = field(default_factory=dict)
-
-    @property
-    def accepted(self) -> list[Candidate]:
-        """Every mechanism the selection accepted (named or partial), in the order accepted."""
-        return [c for s in self.steps for c in s.candidates if c.accepted]
-
-    @property
-    def found(self) -> list[str]:
-        """Names of the mechanisms named as causes: accepted, and the final model leaves no systematic residual
-        in a response they move."""
-        return [n for c in self.accepted if not c.partial for n in c.names]
-
-    @property
-    def partial(self) -> list[Candidate]:
-        """Accepted mechanisms not named: the final model still leaves a systematic residual where they act."""
-        return [c for c in self.accepted if c.partial]
-
-    @property
-    def ambiguities(self) -> list[list[str]]:
-        return [s.ambiguity for s in self.steps if s.ambiguity]
-
-    @property
-    def candidates(self) -> list[Candidate]:
-        """The first step's candidates (every mechanism tried on the classical model), best BIC first."""
-        return self.steps[0].candidates if self.steps else []
-
-    def explained_share(self) -> float:
-        """Share of the baseline's systematic residual (training rows) the final model removes."""
-        before = self.lack_of_fit["baseline"]["systematic"]
-        return 1.0 - self.lack_of_fit["final"]["systematic"] / before if before > 0 else 1.0
-
-    def to_dict(self) -> dict:
-        def model(fit, heldout):
-            return {"parameters": fit.free, "parameter_table": fit.parameter_table(), "train_rmse": fit.rmse,
-                    "heldout_rmse": heldout, "at_bounds": fit.at_bounds(), "unidentified": sorted(fit.unidentified())}
-
-        return {
-            "responses": list(self.responses), "scales": self.scales, "n_train": self.n_train,
-            "n_heldout": self.n_heldout,
-            "found": self.found,
-            "accepted": [c.to_dict() for c in self.accepted if not c.partial],
-            "partial": [c.to_dict() for c in self.partial],
-            "ambiguities": self.ambiguities,
-            "unexplained": self.unexplained,
-            "baseline": model(self.baseline, self.baseline_heldout_rmse),
-            "final": {"mechanisms": [n for c in self.accepted for n in c.names], **model(self.final, self.final_heldout_rmse),
-                      "explained_share": self.explained_share()},
-            "steps": [s.to_dict() for s in self.steps],
-            "residual_trends": self.trends[:12],
-            "lack_of_fit": {k: {q: {"p_value": r["p_value"], "systematic": r["systematic"]}
-                                for q, r in v["responses"].items()} for k, v in self.lack_of_fit.items()},
-            "not_applicable": self.skipped,
-        }
-
-
 def _fit_extended(train, current: Fit, free, start: SoilParameters, exts: tuple[Extension, ...], responses,
                   scales, starts: list[SoilParameters] | None = None) -> Fit:
     """The current model plus ``exts`` fitted from the current fit, and from the current fit with the cohesion
@@ -382,15 +180,8 @@ def _heldout(soil, test, responses, scales) -> np.ndarray:
     return normalised_residuals(soil, test, responses, scales)
 
 
-def discover(data: Measurements, *, start: SoilParameters | None = None, responses=None, heldout=None,
-             candidates=None, bootstrap: int = 400, seed: int = 0, max_steps: int = 4) -> Discovery:
-    """Run the workflow on ``data`` (see the module docstring).
-
-    start: parameters to start from; the baseline's extension parameters are switched off
-        (:data:`~.extensions.BASELINE_OFF`). responses: which measured responses to fit (default: those
-        with data). heldout: boolean mask of held-out rows (default: a seeded random 30 %). candidates:
-        extension names to try (default: all that the data can show). max_steps: most mechanisms accepted.
-    """
+def _checked_inputs(data: Measurements, responses, candidates) -> tuple[tuple, list]:
+    """The responses to fit (default: those with data) and the candidates' names, refused with the allowed ones."""
     if len(data) < 8:
         raise WheelsoilInputError(f"{data.name}: {len(data)} measurements are too few to calibrate and hold out")
     responses = tuple(responses or [q for q in RESPONSES if np.isfinite(data.responses.get(q, np.nan * data.slip)).any()])
@@ -401,6 +192,120 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
     bad = [n for n in names if n not in EXTENSIONS]
     if bad:
         raise WheelsoilInputError(f"unknown candidate(s) {bad}; choose from {sorted(EXTENSIONS)}")
+    return responses, names
+
+
+class _Search:
+    """The forward selection's state (module docstring): the training and held-out rows, the model accepted so far,
+    its free parameters and lack of fit, the steps taken, and the random stream of the held-out bootstraps (drawn in
+    the order the candidates are tried)."""
+
+    def __init__(self, data, train, test, responses, scales, base_start, baseline: Fit, lack: dict, bootstrap: int,
+                 seed: int) -> None:
+        self.data, self.train, self.test = data, train, test
+        self.responses, self.scales, self.base_start, self.bootstrap = responses, scales, base_start, bootstrap
+        self.rng = np.random.default_rng(seed)
+        self.current, self.names, self.free = baseline, (), BASELINE_FREE
+        self.lack = lack
+        self.steps: list[Step] = []
+
+    def _fit(self, exts, current=None, free=None, **kw) -> Fit:
+        current = self.current if current is None else current
+        free = self.free if free is None else free
+        return _fit_extended(self.train, current, free, self.base_start, exts, self.responses, self.scales, **kw)
+
+    def heldout_error(self, soil) -> np.ndarray:
+        return _heldout(soil, self.test, self.responses, self.scales)
+
+    def trial(self, exts, fit: Fit, cur_err, cur_rmse, needs=None) -> Candidate:
+        """A candidate's evidence against the current model: held-out gain (paired bootstrap), BIC, effect, the
+        systematic residual it removes, its parameters' problems."""
+        err = self.heldout_error(fit.soil)
+        rmse = float(np.sqrt(np.mean(err ** 2)))
+        idx = self.rng.integers(0, err.size, size=(self.bootstrap, err.size))  # paired bootstrap of the RMSE difference
+        diffs = np.sqrt(np.mean(cur_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
+        lack_new, _ = _lack_of_fit(fit.soil, self.train, self.responses, self.scales)
+        before = self.lack["systematic"]
+        explained = 1.0 - lack_new["systematic"] / before if before > 0 else 0.0
+        data, responses, scales = self.data, self.responses, self.scales
+        return Candidate(exts[0], len(self.steps), fit, rmse, cur_rmse - rmse, float(np.std(diffs)),
+                         fit.bic - self.current.bic, mechanism_effect(fit.soil, exts, data, responses, scales),
+                         float(explained), _parameter_problems(exts, fit),
+                         effect_by_response=mechanism_effect(fit.soil, exts, data, responses, scales,
+                                                             by_response=True),
+                         partner=exts[1] if len(exts) > 1 else None, needs=needs or {})
+
+    def step(self, remaining: list, max_steps: int) -> tuple[Step, list]:
+        """Try every remaining mechanism alone; where none passes and a trend is unexplained, the best pairs
+        (look-ahead). Returns the last step taken and its passing candidates, best first."""
+        cur_err = self.heldout_error(self.current.soil)
+        cur_rmse = float(np.sqrt(np.mean(cur_err ** 2)))
+        singles = [self.trial((EXTENSIONS[name],), self._fit((EXTENSIONS[name],)), cur_err, cur_rmse)
+                   for name in remaining]
+        singles.sort(key=lambda c: c.fit.bic)
+        step = Step(len(self.steps), self.names, cur_rmse, self.lack["systematic"], singles)
+        self.steps.append(step)
+        passing = [c for c in singles if c.passes]
+        if (not passing and len(self.names) + 2 <= max_steps and len(singles) >= 2
+                and unexplained_trends(self.lack, [])):
+            step = self._pair_step(singles, cur_err, cur_rmse)
+            passing = [c for c in step.candidates if c.passes]
+        return step, passing
+
+    def _pair_step(self, singles: list, cur_err, cur_rmse) -> Step:
+        """Look-ahead: two mechanisms that act together can each fail alone; the best :data:`PAIR_POOL` singles are
+        fitted in pairs, each started from either member's own fit."""
+        by_name = {c.extension.name: c for c in singles}
+        pool = [c.extension for c in singles[:PAIR_POOL]]
+        pairs = []
+        for a, b in combinations(pool, 2):
+            fa, fb = by_name[a.name].fit, by_name[b.name].fit
+            joint = self._fit((a, b), starts=[replace(fa.soil, **_mid(b)), replace(fb.soil, **_mid(a))])
+            pairs.append(self.trial((a, b), joint, cur_err, cur_rmse,
+                                    needs={b.name: joint.bic - fa.bic, a.name: joint.bic - fb.bic}))
+        pairs.sort(key=lambda c: c.fit.bic)
+        step = Step(len(self.steps), self.names, cur_rmse, self.lack["systematic"], pairs, pairs=True)
+        self.steps.append(step)
+        return step
+
+    def unresolved(self, step: Step, best: Candidate, passing: list) -> list[str]:
+        """The rivals ``best`` does not beat: passing candidates within :data:`AMBIGUITY_MARGIN` that add nothing
+        joined to it, then (where none) the generic drifts that fit better by :data:`RIVAL_MARGIN`."""
+        unresolved = []
+        for rival in passing[1:]:
+            if rival.fit.bic - best.fit.bic >= AMBIGUITY_MARGIN:
+                continue
+            if rival.partner is not None:  # two pairs about equally good
+                unresolved.append(rival.name)
+                continue
+            joint = self._fit((rival.extension,), current=best.fit, free=self.free + best.extension.parameters)
+            if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems((rival.extension,), joint):
+                unresolved.append(rival.name)
+        if not unresolved:
+            step.rivals = _drift_rivals(self.train, self.current, self.free, best, self.responses, self.scales)
+            unresolved = [r["name"] for r in step.rivals if r["bic_vs_accepted"] < -RIVAL_MARGIN]
+        return unresolved
+
+    def accept(self, step: Step, best: Candidate, remaining: list) -> None:
+        best.accepted = True
+        step.accepted = best.name
+        self.current, self.names = best.fit, self.names + tuple(best.names)
+        self.free = self.free + tuple(p for e in best.extensions for p in e.parameters)
+        for n in best.names:
+            remaining.remove(n)
+        self.lack, _ = _lack_of_fit(self.current.soil, self.train, self.responses, self.scales)
+
+
+def discover(data: Measurements, *, start: SoilParameters | None = None, responses=None, heldout=None,
+             candidates=None, bootstrap: int = 400, seed: int = 0, max_steps: int = 4) -> Discovery:
+    """Run the workflow on ``data`` (see the module docstring).
+
+    start: parameters to start from; the baseline's extension parameters are switched off
+        (:data:`~.extensions.BASELINE_OFF`). responses: which measured responses to fit (default: those
+        with data). heldout: boolean mask of held-out rows (default: a seeded random 30 %). candidates:
+        extension names to try (default: all that the data can show). max_steps: most mechanisms accepted.
+    """
+    responses, names = _checked_inputs(data, responses, candidates)
     heldout = holdout_mask(data, seed=seed) if heldout is None else np.asarray(heldout, bool)
     train, test = data.select(~heldout), data.select(heldout)
     scales = response_scales(train, responses)
@@ -410,90 +315,26 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
 
     skipped = {n: "the data cannot show it" for n in names if not EXTENSIONS[n].applies(data)}
     remaining = [n for n in names if n not in skipped]
-    rng = np.random.default_rng(seed)
-    current, current_names, free = baseline, (), BASELINE_FREE
-    lack_cur = lack_base
-    steps: list[Step] = []
-
-    def trial(exts, fit, cur_err, cur_rmse, needs=None) -> Candidate:
-        err = _heldout(fit.soil, test, responses, scales)
-        rmse = float(np.sqrt(np.mean(err ** 2)))
-        idx = rng.integers(0, err.size, size=(bootstrap, err.size))  # paired bootstrap of the RMSE difference
-        diffs = np.sqrt(np.mean(cur_err[idx] ** 2, axis=1)) - np.sqrt(np.mean(err[idx] ** 2, axis=1))
-        lack_new, _ = _lack_of_fit(fit.soil, train, responses, scales)
-        before = lack_cur["systematic"]
-        explained = 1.0 - lack_new["systematic"] / before if before > 0 else 0.0
-        return Candidate(exts[0], len(steps), fit, rmse, cur_rmse - rmse, float(np.std(diffs)),
-                         fit.bic - current.bic, mechanism_effect(fit.soil, exts, data, responses, scales),
-                         float(explained), _parameter_problems(exts, fit),
-                         effect_by_response=mechanism_effect(fit.soil, exts, data, responses, scales,
-                                                             by_response=True),
-                         partner=exts[1] if len(exts) > 1 else None, needs=needs or {})
-
-    while remaining and len(current_names) < max_steps:
-        cur_err = _heldout(current.soil, test, responses, scales)
-        cur_rmse = float(np.sqrt(np.mean(cur_err ** 2)))
-        singles = []
-        for name in remaining:
-            ext = EXTENSIONS[name]
-            singles.append(trial((ext,), _fit_extended(train, current, free, base_start, (ext,), responses, scales),
-                                 cur_err, cur_rmse))
-        singles.sort(key=lambda c: c.fit.bic)
-        tried = singles
-        step = Step(len(steps), current_names, cur_rmse, lack_cur["systematic"], tried)
-        steps.append(step)
-        passing = [c for c in tried if c.passes]
-        if (not passing and len(current_names) + 2 <= max_steps and len(singles) >= 2
-                and unexplained_trends(lack_cur, [])):
-            # look-ahead: two mechanisms that act together can each fail alone
-            by_name = {c.extension.name: c for c in singles}
-            pool = [c.extension for c in singles[:PAIR_POOL]]
-            pairs = []
-            for a, b in combinations(pool, 2):
-                fa, fb = by_name[a.name].fit, by_name[b.name].fit
-                joint = _fit_extended(train, current, free, base_start, (a, b), responses, scales,
-                                      starts=[replace(fa.soil, **_mid(b)), replace(fb.soil, **_mid(a))])
-                pairs.append(trial((a, b), joint, cur_err, cur_rmse,
-                                   needs={b.name: joint.bic - fa.bic, a.name: joint.bic - fb.bic}))
-            pairs.sort(key=lambda c: c.fit.bic)
-            step = Step(len(steps), current_names, cur_rmse, lack_cur["systematic"], pairs, pairs=True)
-            steps.append(step)
-            tried, passing = pairs, [c for c in pairs if c.passes]
+    search = _Search(data, train, test, responses, scales, base_start, baseline, lack_base, bootstrap, seed)
+    while remaining and len(search.names) < max_steps:
+        step, passing = search.step(remaining, max_steps)
         if not passing:
             break
         best = passing[0]
-        unresolved = []
-        for rival in passing[1:]:
-            if rival.fit.bic - best.fit.bic >= AMBIGUITY_MARGIN:
-                continue
-            if rival.partner is not None:  # two pairs about equally good
-                unresolved.append(rival.name)
-                continue
-            joint = _fit_extended(train, best.fit, free + best.extension.parameters, base_start,
-                                  (rival.extension,), responses, scales)
-            if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems((rival.extension,), joint):
-                unresolved.append(rival.name)
-        if not unresolved:
-            step.rivals = _drift_rivals(train, current, free, best, responses, scales)
-            unresolved = [r["name"] for r in step.rivals if r["bic_vs_accepted"] < -RIVAL_MARGIN]
+        unresolved = search.unresolved(step, best, passing)
         if unresolved:
             step.ambiguity = [best.name] + unresolved
             break
-        best.accepted = True
-        step.accepted = best.name
-        current, current_names = best.fit, current_names + tuple(best.names)
-        free = free + tuple(p for e in best.extensions for p in e.parameters)
-        for n in best.names:
-            remaining.remove(n)
-        lack_cur, _ = _lack_of_fit(current.soil, train, responses, scales)
-    final_err = _heldout(current.soil, test, responses, scales)
+        search.accept(step, best, remaining)
+    current, steps = search.current, search.steps
+    final_err = search.heldout_error(current.soil)
     _, final_trends = _lack_of_fit(current.soil, train, responses, scales)
-    unexplained = unexplained_trends(lack_cur, final_trends)
+    unexplained = unexplained_trends(search.lack, final_trends)
     for s in steps:
         for c in s.candidates:
             if c.accepted:
                 c.partial = [u["text"] for u in unexplained if u["response"] in c.moves()]
-    return Discovery(baseline, float(np.sqrt(np.mean(_heldout(baseline.soil, test, responses, scales) ** 2))), steps,
+    return Discovery(baseline, float(np.sqrt(np.mean(search.heldout_error(baseline.soil) ** 2))), steps,
                      current, float(np.sqrt(np.mean(final_err ** 2))), trends,
-                     {"baseline": lack_base, "final": lack_cur}, unexplained, responses, scales, len(train), len(test),
+                     {"baseline": lack_base, "final": search.lack}, unexplained, responses, scales, len(train), len(test),
                      skipped)
