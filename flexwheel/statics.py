@@ -146,42 +146,21 @@ def solve_static(
     tangential displacement over its distance from the axis) is applied as a finite rotation, and only the
     rest of its step linearly: what stretches then is the turn's gradient, not the turn.
     """
-    import scipy.sparse.linalg as spla
-
-    from .linear import assemble_stiffness
-    from .mesh import StructureMesh
-
     mesh = structure.mesh
     n = mesh.n_nodes
     fixed = np.zeros(n, bool)
     fixed[np.asarray(fixed_nodes, np.int64)] = True
     free_dofs = (6 * np.flatnonzero(~fixed)[:, None] + np.arange(6)).ravel()
     ext = np.zeros((n, 6)) if loads is None else np.asarray(loads, float).reshape(n, 6)
+    axis = None if axis is None else np.asarray(axis, float) / np.linalg.norm(axis)
 
     def forces(x, rot):
         structure.set_state(positions=x, rotations=rot)
         f, m = structure.internal_forces()
         return np.c_[f, m] + ext
 
-    free_nodes = np.flatnonzero(~fixed)
-    axis = None if axis is None else np.asarray(axis, float) / np.linalg.norm(axis)
-
     def moved(x, rot, d):
-        d = d.reshape(n, 6)
-        if axis is None:
-            return x + d[:, :3], rotation_matrices(d[:, 3:]) @ rot
-        # each free node's turn about the axis (its tangential displacement over its distance from the axis),
-        # applied as a finite rotation; the rest of its step linearly
-        p = x[free_nodes]
-        perp = p - np.outer(p @ axis, axis)
-        r2 = np.maximum(np.sum(perp * perp, axis=1), 1e-300)
-        phi = (np.cross(perp, d[free_nodes, :3]) @ axis) / r2
-        turn = rotation_matrices(phi[:, None] * axis[None, :])
-        rest = d[free_nodes, :3] - phi[:, None] * np.cross(axis, perp)
-        x_new, rot_new = x.copy(), rot.copy()
-        x_new[free_nodes] = np.einsum("kij,kj->ki", turn, p) + rest
-        rot_new[free_nodes] = turn @ rotation_matrices(d[free_nodes, 3:] - phi[:, None] * axis[None, :]) @ rot[free_nodes]
-        return x_new, rot_new
+        return _increment(x, rot, d.reshape(n, 6), np.flatnonzero(~fixed), axis)
 
     x = structure.positions()
     rot = structure.rotations()
@@ -197,38 +176,73 @@ def solve_static(
             return StaticSolution(True, it, residual)
         if it == max_iterations:
             break
-        current = StructureMesh(x, mesh.triangles, mesh.thickness, mesh.material, beams=mesh.beams,
-                                beam_section=mesh.beam_section if len(mesh.beams) else None,
-                                beam_orientation=mesh.beam_orientation if len(mesh.beams) else None,
-                                drilling_penalty=mesh.drilling_penalty)
-        lu = spla.splu(assemble_stiffness(current).tocsr()[free_dofs][:, free_dofs].tocsc())
-        base = total.reshape(-1)[free_dofs]
-
-        def jacobian(v, x=x, rot=rot, base=base):
-            norm = np.linalg.norm(v)
-            if norm == 0.0:
-                return np.zeros_like(v)
-            eps = 1e-7 * length / norm
-            d = np.zeros(6 * n)
-            d[free_dofs] = eps * v
-            return -(forces(*moved(x, rot, d)).reshape(-1)[free_dofs] - base) / eps
-
-        size = len(free_dofs)
-        op = spla.LinearOperator((size, size), matvec=jacobian)
-        pre = spla.LinearOperator((size, size), matvec=lu.solve)
-        step, _ = spla.gmres(op, r, M=pre, x0=lu.solve(r), rtol=1e-4, restart=30, maxiter=3)
-        # backtracking: halve a step that multiplies the residual (Newton from far away can overshoot; a
-        # good step may still raise the force residual for a while -- stiff membrane forces of second order
-        # in a soft mode's displacement -- so only a tenfold rise counts)
-        old = np.linalg.norm(r)
-        for _ in range(8):
-            d = np.zeros(6 * n)
-            d[free_dofs] = step
-            x_new, rot_new = moved(x, rot, d)
-            trial = forces(x_new, rot_new)
-            if np.linalg.norm(trial.reshape(-1)[free_dofs]) < 10.0 * old:
-                break
-            step = 0.5 * step
-        x, rot, total = x_new, rot_new, trial
+        step = _newton_krylov_step(mesh, x, rot, total, free_dofs, forces, moved, length)
+        x, rot, total = _backtrack(x, rot, step, r, free_dofs, n, forces, moved)
     structure.set_state(positions=x, rotations=rot)
     return StaticSolution(False, max_iterations, residual)
+
+
+def _increment(x: np.ndarray, rot: np.ndarray, d: np.ndarray, free_nodes: np.ndarray, axis) -> tuple:
+    """Positions and rotations after the step ``d`` (n, 6): x + d, R <- exp(d theta) R; with ``axis``, each free
+    node's turn about it (its tangential displacement over its distance from the axis) applied as a finite rotation
+    and only the rest of its step linearly (:func:`solve_static`)."""
+    if axis is None:
+        return x + d[:, :3], rotation_matrices(d[:, 3:]) @ rot
+    p = x[free_nodes]
+    perp = p - np.outer(p @ axis, axis)
+    r2 = np.maximum(np.sum(perp * perp, axis=1), 1e-300)
+    phi = (np.cross(perp, d[free_nodes, :3]) @ axis) / r2
+    turn = rotation_matrices(phi[:, None] * axis[None, :])
+    rest = d[free_nodes, :3] - phi[:, None] * np.cross(axis, perp)
+    x_new, rot_new = x.copy(), rot.copy()
+    x_new[free_nodes] = np.einsum("kij,kj->ki", turn, p) + rest
+    rot_new[free_nodes] = turn @ rotation_matrices(d[free_nodes, 3:] - phi[:, None] * axis[None, :]) @ rot[free_nodes]
+    return x_new, rot_new
+
+
+def _newton_krylov_step(mesh, x, rot, total, free_dofs, forces, moved, length: float) -> np.ndarray:
+    """One Newton step on the free dofs: J d = r by GMRES, J applied as the forward-difference derivative of the
+    internal forces, preconditioned by the small-strain stiffness in the current configuration (:func:`solve_static`)."""
+    import scipy.sparse.linalg as spla
+
+    from .linear import assemble_stiffness
+    from .mesh import StructureMesh
+
+    n = mesh.n_nodes
+    current = StructureMesh(x, mesh.triangles, mesh.thickness, mesh.material, beams=mesh.beams,
+                            beam_section=mesh.beam_section if len(mesh.beams) else None,
+                            beam_orientation=mesh.beam_orientation if len(mesh.beams) else None,
+                            drilling_penalty=mesh.drilling_penalty)
+    lu = spla.splu(assemble_stiffness(current).tocsr()[free_dofs][:, free_dofs].tocsc())
+    base = total.reshape(-1)[free_dofs]
+
+    def jacobian(v):
+        norm = np.linalg.norm(v)
+        if norm == 0.0:
+            return np.zeros_like(v)
+        eps = 1e-7 * length / norm
+        d = np.zeros(6 * n)
+        d[free_dofs] = eps * v
+        return -(forces(*moved(x, rot, d)).reshape(-1)[free_dofs] - base) / eps
+
+    size = len(free_dofs)
+    op = spla.LinearOperator((size, size), matvec=jacobian)
+    pre = spla.LinearOperator((size, size), matvec=lu.solve)
+    step, _ = spla.gmres(op, base, M=pre, x0=lu.solve(base), rtol=1e-4, restart=30, maxiter=3)
+    return step
+
+
+def _backtrack(x, rot, step, r, free_dofs, n: int, forces, moved) -> tuple:
+    """The state after ``step``, halved (at most eight times) while it multiplies the residual tenfold: Newton from
+    far away can overshoot, and a good step may still raise the force residual for a while (stiff membrane forces
+    of second order in a soft mode's displacement), so only a tenfold rise counts. Returns (x, rot, forces)."""
+    old = np.linalg.norm(r)
+    for _ in range(8):
+        d = np.zeros(6 * n)
+        d[free_dofs] = step
+        x_new, rot_new = moved(x, rot, d)
+        trial = forces(x_new, rot_new)
+        if np.linalg.norm(trial.reshape(-1)[free_dofs]) < 10.0 * old:
+            break
+        step = 0.5 * step
+    return x_new, rot_new, trial
