@@ -235,6 +235,49 @@ def deseasonalised(means: np.ndarray, period: int) -> np.ndarray:
     return out
 
 
+def _pitch_means(t, angle, v, series: dict, bounds) -> tuple:
+    """Per pitch, in time order: its duration [s], the tread's turn [rad], the mean travel speed and each series'
+    mean (``bounds``: :func:`pitch_boundaries`, latest first)."""
+    pairs = list(zip(bounds[1:], bounds[:-1]))[::-1]  # (start, end) of each pitch, in time order
+    durations = np.array([t[e - 1] - t[s - 1] for s, e in pairs])
+    turned = np.array([angle[e - 1] - angle[s - 1] for s, e in pairs])
+    speeds = np.array([v[s:e].mean() for s, e in pairs])
+    batches = {name: np.array([np.asarray(y, float)[s:e].mean() for s, e in pairs]) for name, y in series.items()}
+    return durations, turned, speeds, batches
+
+
+def _quantity_reasons(name: str, st: dict, tolerance: float, floors: dict, zero_within: float) -> list[str]:
+    """Why quantity ``name``'s window statistics ``st`` are not steady (empty: steady); sets its
+    ``zero_within_noise``. A quantity zero within its noise has no value to hold: it is steady when it does not
+    trend beyond its noise; any other must drift, and change between the window's halves, by less than the
+    tolerance times the larger of its mean and its floor."""
+    allowed = tolerance * max(abs(st["mean"]), floors.get(name, 0.0))
+    st["zero_within_noise"] = bool(abs(st["mean"]) < zero_within * st["sem"])
+    if st["zero_within_noise"]:
+        if abs(st["drift"]) > zero_within * st["drift_sem"] or abs(st["step"]) > zero_within * st["step_sem"]:
+            return [f"{name} is zero within its noise ({st['mean']:+.3g} +- {st['sem']:.2g}) but trends: "
+                    f"drift {st['drift']:+.4g} +- {st['drift_sem']:.2g}, change between the window's halves "
+                    f"{st['step']:+.4g} +- {st['step_sem']:.2g} (allowed: {zero_within:g} standard errors)"]
+    elif abs(st["drift"]) > allowed:
+        return [f"{name} drifts by {st['drift']:+.4g} +- {st['drift_sem']:.2g} over the window (allowed "
+                f"+-{allowed:.3g})" + ("; within its own noise: a longer window would tell"
+                                       if abs(st["drift"]) < 2.0 * st["drift_sem"] else "")]
+    elif abs(st["step"]) > allowed:
+        return [f"{name} changes by {st['step']:+.4g} between the window's halves (allowed +-{allowed:.3g})"]
+    return []
+
+
+def _tread_slip_stats(slip: float, per_pitch: np.ndarray, noise: dict, dof: int, period_pitches: int) -> dict:
+    """The window's tread slip ``slip`` with its standard error (from every pitch since the earliest start where the
+    slip was a checked series, else from the window's ``per_pitch`` slips), its 95 % interval and drift."""
+    m = len(per_pitch)
+    slip_noise = noise.get("tread_slip", pitch_noise(per_pitch, period_pitches))
+    slip_sem = slip_noise / math.sqrt(m)
+    slip_dof = dof if "tread_slip" in noise else pitch_noise_dof(m, period_pitches)
+    return {"mean": slip, "std": float(np.std(per_pitch)), "sem": slip_sem, "dof": slip_dof,
+            "ci95": t_quantile(slip_dof) * slip_sem, "drift": periodic_trend(per_pitch, period_pitches)[0] * (m - 1)}
+
+
 def detect_steady_state(
     t: np.ndarray,
     series: dict,
@@ -289,12 +332,8 @@ def detect_steady_state(
     if len(bounds) - 1 < min_pitches:
         return short
     n_pitches = (len(bounds) - 1)
-    pairs_all = list(zip(bounds[1:], bounds[:-1]))[::-1]  # (start, end) of each pitch, in time order
-    durations = np.array([t[e - 1] - t[s - 1] for s, e in pairs_all])
-    turned = np.array([angle[e - 1] - angle[s - 1] for s, e in pairs_all])
-    speeds = np.array([v[s:e].mean() for s, e in pairs_all])
+    durations, turned, speeds, batches = _pitch_means(t, angle, v, series, bounds)
     per_pitch_slip = longitudinal_slip(speeds, turned / durations, radius)
-    batches = {name: np.array([np.asarray(y, float)[s:e].mean() for s, e in pairs_all]) for name, y in series.items()}
     if slip_target is not None:
         batches["tread_slip"] = per_pitch_slip
     # MSER truncation: the latest start any quantity needs, searched over the first half of the pitches since
@@ -315,31 +354,12 @@ def detect_steady_state(
     dof = pitch_noise_dof(n_pitches, period_pitches)
     stats = {name: window_stats(np.asarray(y, float), b, noise=noise[name], period=period_pitches, noise_dof=dof)
              for name, y in series.items()}
-    reasons = []
-    for name, st in stats.items():
-        allowed = tolerance * max(abs(st["mean"]), floors.get(name, 0.0))
-        st["zero_within_noise"] = bool(abs(st["mean"]) < zero_within * st["sem"])
-        if st["zero_within_noise"]:
-            # no value to hold: steady when it does not trend beyond its noise
-            if abs(st["drift"]) > zero_within * st["drift_sem"] or abs(st["step"]) > zero_within * st["step_sem"]:
-                reasons.append(f"{name} is zero within its noise ({st['mean']:+.3g} +- {st['sem']:.2g}) but trends: "
-                               f"drift {st['drift']:+.4g} +- {st['drift_sem']:.2g}, change between the window's halves "
-                               f"{st['step']:+.4g} +- {st['step_sem']:.2g} (allowed: {zero_within:g} standard errors)")
-        elif abs(st["drift"]) > allowed:
-            reasons.append(f"{name} drifts by {st['drift']:+.4g} +- {st['drift_sem']:.2g} over the window (allowed "
-                           f"+-{allowed:.3g})" + ("; within its own noise: a longer window would tell"
-                                                  if abs(st["drift"]) < 2.0 * st["drift_sem"] else ""))
-        elif abs(st["step"]) > allowed:
-            reasons.append(f"{name} changes by {st['step']:+.4g} between the window's halves (allowed +-{allowed:.3g})")
+    reasons = [r for name, st in stats.items() for r in _quantity_reasons(name, st, tolerance, floors, zero_within)]
     w = slice(n_pitches - m, n_pitches)
     spin = turned[w].sum() / durations[w].sum()
     slip = longitudinal_slip(float(speeds[w] @ durations[w] / durations[w].sum()), spin, radius)
-    slip_noise = noise.get("tread_slip", pitch_noise(per_pitch_slip[w], period_pitches))
-    slip_sem = slip_noise / math.sqrt(m)
-    slip_drift = periodic_trend(per_pitch_slip[w], period_pitches)[0] * (m - 1)
-    slip_dof = dof if "tread_slip" in noise else pitch_noise_dof(m, period_pitches)
-    stats["tread_slip"] = {"mean": slip, "std": float(np.std(per_pitch_slip[w])), "sem": slip_sem, "dof": slip_dof,
-                           "ci95": t_quantile(slip_dof) * slip_sem, "drift": slip_drift}
+    stats["tread_slip"] = _tread_slip_stats(slip, per_pitch_slip[w], noise, dof, period_pitches)
+    slip_sem, slip_drift = stats["tread_slip"]["sem"], stats["tread_slip"]["drift"]
     if slip_target is not None:
         if not abs(slip - slip_target) <= slip_tolerance:
             reasons.append(f"tread slip {slip:.3f} differs from the commanded {slip_target:.3f} by more "
