@@ -93,10 +93,75 @@ def assembled_critical_frequency(mesh: StructureMesh) -> float:
     a = (scale @ assemble_stiffness(mesh) @ scale).tocsr()
     tol = 1e-8
     try:
-        lam = float(spla.eigsh(a, k=1, which="LA", return_eigenvectors=False, tol=tol, maxiter=20 * a.shape[0])[0])
+        # a fixed start vector: ARPACK's default is random, which moved the step by ~1e-11 between runs
+        lam = float(spla.eigsh(a, k=1, which="LA", return_eigenvectors=False, tol=tol, maxiter=20 * a.shape[0],
+                               v0=np.ones(a.shape[0]))[0])
     except (spla.ArpackNoConvergence, spla.ArpackError):
         return bound
     return min(bound, math.sqrt(lam * (1.0 + 1e3 * tol)))
+
+
+def element_arrays(mesh: StructureMesh) -> dict:
+    """The facets' (tri, frame0, local0, km, kb) and beams' (ends, bframe0, blen0, rigidity) device arrays; a mesh
+    without facets or beams gets one-row placeholders the kernels take but never read."""
+    d = {}
+    if len(mesh.triangles):
+        frames, local, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
+        km_packed, kb_packed = pack_stiffness(km, kb)
+        d.update(tri=_nd(ivec3, mesh.triangles.astype(np.int32)), frame0=_nd(mat3, frames), local0=_nd(mat32, local),
+                 km=_nd(ti.f64, km_packed), kb=_nd(ti.f64, kb_packed))
+    else:
+        d.update(tri=_nd(ivec3, np.zeros((1, 3), np.int32)), frame0=_nd(mat3, np.eye(3)[None]),
+                 local0=_nd(mat32, np.zeros((1, 3, 2))), km=_nd(ti.f64, np.zeros((1, len(MEMBRANE_PACK)))),
+                 kb=_nd(ti.f64, np.zeros((1, len(BENDING_PACK)))))
+    if len(mesh.beams):
+        bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
+        d.update(ends=_nd(ivec2, mesh.beams.astype(np.int32)), bframe0=_nd(mat3, bframes), blen0=_nd(ti.f64, blen),
+                 rigidity=_nd(vec4, beam_section_stiffness(mesh.beam_section, mesh.material)))
+    else:
+        d.update(ends=_nd(ivec2, np.array([[0, 0]], np.int32)), bframe0=_nd(mat3, np.eye(3)[None]),
+                 blen0=_nd(ti.f64, np.ones(1)), rigidity=_nd(vec4, np.zeros((1, 4))))
+    return d
+
+
+def slot_arrays(mesh: StructureMesh) -> dict:
+    """The element corners: each node's corner slots (slot_start, slot_list; facets' corners first, then beams'
+    ends) and the corners' forces and moments (slot_f, slot_m)."""
+    n = mesh.n_nodes
+    slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
+    order = np.argsort(slot_node, kind="stable")
+    start = np.zeros(n + 1, np.int32)
+    np.add.at(start, slot_node + 1, 1)
+    n_slots = len(slot_node)
+    return {"slot_start": _nd(ti.i32, np.cumsum(start).astype(np.int32)), "slot_list": _nd(ti.i32, order.astype(np.int32)),
+            "slot_f": _vec(np.zeros((n_slots, 3))), "slot_m": _vec(np.zeros((n_slots, 3)))}
+
+
+def node_arrays(mesh: StructureMesh, mass: np.ndarray, inertia: np.ndarray, tied: np.ndarray) -> dict:
+    """The nodes' state at rest in the mesh's positions, their lumped mass and inertia (1 where a node tied to the
+    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants."""
+    n = mesh.n_nodes
+    zeros = np.zeros((n, 3))
+    return {"x": _vec(mesh.nodes), "v": _vec(zeros), "rot": _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3))),
+            "w": _vec(zeros), "mass": _nd(ti.f64, np.where(mass > 0, mass, 1.0)),
+            "inertia": _nd(ti.f64, np.where(inertia > 0, inertia, 1.0)), "free": _nd(ti.i32, (~tied).astype(np.int32)),
+            "f_ext": _vec(zeros), "k_ext": _nd(ti.f64, np.zeros(n)), "x_anchor": _vec(mesh.nodes), "m_ext": _vec(zeros),
+            "f_tot": _vec(zeros), "m_tot": _vec(zeros), "peak": _nd(ti.f64, np.zeros(2))}
+
+
+def hub_arrays(mesh: StructureMesh, hub: np.ndarray, center: np.ndarray, hub_mass: float, hub_inertia) -> dict:
+    """The hub's nodes and their offsets from its ``center`` [m], its state rows (:data:`.integrator.HUB_ROWS`), its
+    rotation and its own mass [kg] and inertia [kg m^2]; without a hub, placeholders the kernels never read."""
+    if not hub.size:
+        return {"hub_nodes": _nd(ti.i32, np.zeros(1, np.int32)), "hub_offset": _vec(np.zeros((1, 3))),
+                "hub": _vec(np.zeros((itg.HUB_ROWS, 3))), "hub_rot": _nd(mat3, np.eye(3)[None]),
+                "hub_scalar": _nd(ti.f64, np.zeros(2))}
+    state = np.zeros((itg.HUB_ROWS, 3))
+    state[itg.HUB_POSITION] = center
+    state[itg.HUB_OWN_INERTIA] = np.asarray(hub_inertia, float)
+    return {"hub_nodes": _nd(ti.i32, hub.astype(np.int32)), "hub_offset": _vec(mesh.nodes[hub] - center),
+            "hub": _vec(state), "hub_rot": _nd(mat3, np.eye(3)[None]),
+            "hub_scalar": _nd(ti.f64, np.array([float(hub_mass), 0.0]))}
 
 
 class Structure:
@@ -172,84 +237,18 @@ class Structure:
         if hub_mass < 0 or any(i < 0 for i in hub_inertia):
             raise WheelsoilInputError(f"hub_mass={hub_mass!r} and hub_inertia={tuple(hub_inertia)!r} must be >= 0")
 
-        # ---- element data
         self.n_facets, self.n_beams = len(mesh.triangles), len(mesh.beams)
         self._slot_beam_base = 3 * self.n_facets
         n_slots = 3 * self.n_facets + 2 * self.n_beams
-        d = {}
-        if self.n_facets:
-            frames, local, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
-            d["tri"] = _nd(ivec3, mesh.triangles.astype(np.int32))
-            d["frame0"] = _nd(mat3, frames)
-            d["local0"] = _nd(mat32, local)
-            km_packed, kb_packed = pack_stiffness(km, kb)
-            d["km"] = _nd(ti.f64, km_packed)
-            d["kb"] = _nd(ti.f64, kb_packed)
-        else:
-            d["tri"] = _nd(ivec3, np.zeros((1, 3), np.int32))
-            d["frame0"] = _nd(mat3, np.eye(3)[None])
-            d["local0"] = _nd(mat32, np.zeros((1, 3, 2)))
-            d["km"] = _nd(ti.f64, np.zeros((1, len(MEMBRANE_PACK))))
-            d["kb"] = _nd(ti.f64, np.zeros((1, len(BENDING_PACK))))
-        if self.n_beams:
-            bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
-            d["ends"] = _nd(ivec2, mesh.beams.astype(np.int32))
-            d["bframe0"] = _nd(mat3, bframes)
-            d["blen0"] = _nd(ti.f64, blen)
-            d["rigidity"] = _nd(vec4, beam_section_stiffness(mesh.beam_section, mesh.material))
-        else:
-            d["ends"] = _nd(ivec2, np.array([[0, 0]], np.int32))
-            d["bframe0"] = _nd(mat3, np.eye(3)[None])
-            d["blen0"] = _nd(ti.f64, np.ones(1))
-            d["rigidity"] = _nd(vec4, np.zeros((1, 4)))
-        slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
-        order = np.argsort(slot_node, kind="stable")
-        start = np.zeros(n + 1, np.int32)
-        np.add.at(start, slot_node + 1, 1)
-        d["slot_start"] = _nd(ti.i32, np.cumsum(start).astype(np.int32))
-        d["slot_list"] = _nd(ti.i32, order.astype(np.int32))
-        d["slot_f"] = _vec(np.zeros((n_slots, 3)))
-        d["slot_m"] = _vec(np.zeros((n_slots, 3)))
-
-        # ---- node state
-        d["x"] = _vec(mesh.nodes)
-        d["v"] = _vec(np.zeros((n, 3)))
-        d["rot"] = _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3)))
-        d["w"] = _vec(np.zeros((n, 3)))
-        d["mass"] = _nd(ti.f64, np.where(self.mass > 0, self.mass, 1.0))
-        d["inertia"] = _nd(ti.f64, np.where(self.inertia > 0, self.inertia, 1.0))
-        d["free"] = _nd(ti.i32, (~tied).astype(np.int32))
-        d["f_ext"] = _vec(np.zeros((n, 3)))
-        d["k_ext"] = _nd(ti.f64, np.zeros(n))
-        d["x_anchor"] = _vec(mesh.nodes)
-        d["m_ext"] = _vec(np.zeros((n, 3)))
-        d["f_tot"] = _vec(np.zeros((n, 3)))
-        d["m_tot"] = _vec(np.zeros((n, 3)))
-        d["peak"] = _nd(ti.f64, np.zeros(2))
-
-        # ---- hub
         self.hub_center0 = (
             np.asarray(hub_center, float).reshape(3)
             if hub_center is not None
             else (mesh.nodes[hub].mean(axis=0) if hub.size else np.zeros(3))
         )
-        if not hub.size:  # placeholders: the kernels take them but never read them
-            d["hub_nodes"] = _nd(ti.i32, np.zeros(1, np.int32))
-            d["hub_offset"] = _vec(np.zeros((1, 3)))
-            d["hub"] = _vec(np.zeros((itg.HUB_ROWS, 3)))
-            d["hub_rot"] = _nd(mat3, np.eye(3)[None])
-            d["hub_scalar"] = _nd(ti.f64, np.zeros(2))
-        else:
-            d["hub_nodes"] = _nd(ti.i32, hub.astype(np.int32))
-            d["hub_offset"] = _vec(mesh.nodes[hub] - self.hub_center0)
-            state = np.zeros((itg.HUB_ROWS, 3))
-            state[itg.HUB_POSITION] = self.hub_center0
-            state[itg.HUB_OWN_INERTIA] = np.asarray(hub_inertia, float)
-            d["hub"] = _vec(state)
-            d["hub_rot"] = _nd(mat3, np.eye(3)[None])
-            d["hub_scalar"] = _nd(ti.f64, np.array([float(hub_mass), 0.0]))
         self.hub_mass_total = float(hub_mass + self.mass[hub].sum())
-        self.arrays = stepper.StructureArrays(**d)
+        self.arrays = stepper.StructureArrays(**element_arrays(mesh), **slot_arrays(mesh),
+                                              **node_arrays(mesh, self.mass, self.inertia, tied),
+                                              **hub_arrays(mesh, hub, self.hub_center0, hub_mass, hub_inertia))
 
         # ---- time step
         if rigid or n_slots == 0:
