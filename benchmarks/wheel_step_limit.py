@@ -1,7 +1,7 @@
 """What limits the wheel's stable step at smoke scale, and what mass scaling would cost to lift it.
 
 The coupled step advances the wheel in two FE sub-steps per DEM step because the wheel's central-difference limit
-(2 / omega_max of the assembled lumped-mass system, :func:`~wheelsoil.flexwheel.structure.assembled_critical_frequency`)
+(2 / omega_max of the assembled lumped-mass system, :func:`~wheelsoil.flexwheel.stability.assembled_critical_frequency`)
 is below the soil's step. This reports, for a case's wheel (default ``smoke-1g-steer``):
 
 * the assembled limit and the element bounds (Irons) per part of the wheel (tread, grousers, spokes), with the
@@ -28,7 +28,8 @@ from wheelsoil.cases import build
 from wheelsoil.cases.schema import load_case
 from wheelsoil.flexwheel.geometry import PARTS, build_wheel_mesh
 from wheelsoil.flexwheel.linear import assemble_stiffness
-from wheelsoil.flexwheel.structure import DEFAULT_SAFETY, critical_frequency
+from wheelsoil.flexwheel.stability import critical_frequency
+from wheelsoil.flexwheel.structure import DEFAULT_SAFETY
 from wheelsoil.granular.materials import effective_modulus
 from wheelsoil.granular.timestep import estimate_time_step
 

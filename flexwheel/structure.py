@@ -17,151 +17,17 @@ import taichi as ti
 
 from wheelsoil import runtime
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
-from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat32, vec3, vec4
-from wheelsoil.taichi_types import to_ndarray as _nd
 
 from . import integrator as itg
 from . import stepper
-from .beam import beam_energies, beam_forces, beam_frames, beam_section_stiffness
+from .beam import beam_energies, beam_forces
 from .mesh import StructureMesh
-from .shell import BENDING_PACK, MEMBRANE_PACK, pack_stiffness, shell_energies, shell_forces, shell_setup
+from .stability import assembled_critical_frequency
+from .structure_arrays import element_arrays, hub_arrays, node_arrays, slot_arrays
+from .shell import shell_energies, shell_forces
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
-
-
-def _vec(values):
-    return _nd(vec3, np.asarray(values, float).reshape(-1, 3))
-
-
-def critical_frequency(mesh: StructureMesh) -> np.ndarray:
-    """Largest circular frequency [rad/s] of every element with its own lumped mass (facets, then beams).
-
-    The largest frequency of the assembled, lumped-mass system never exceeds the largest element one
-    (Irons' element eigenvalue theorem; Hughes, *The Finite Element Method*, sec. 9.1), so the
-    central-difference limit dt < 2 / omega_max computed from these is safe.
-    """
-    fm, fi, bm, bi = mesh.element_masses()
-    out = []
-    if len(mesh.triangles):
-        _, _, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
-        inv_m = 1.0 / np.sqrt(np.stack([fm, fm, fi] * 3, axis=1))
-        inv_b = 1.0 / np.sqrt(np.stack([fm, fi, fi] * 3, axis=1))
-        lam_m = np.linalg.eigvalsh(km * inv_m[:, :, None] * inv_m[:, None, :])[:, -1]
-        lam_b = np.linalg.eigvalsh(kb * inv_b[:, :, None] * inv_b[:, None, :])[:, -1]
-        out.append(np.sqrt(np.maximum(lam_m, lam_b)))
-    if len(mesh.beams):
-        rig = beam_section_stiffness(mesh.beam_section, mesh.material)
-        length = mesh.beam_lengths()
-        lam = np.maximum(2.0 * rig[:, 0] / (length * bm), 2.0 * rig[:, 1] / (length * bi))
-        for ei in (rig[:, 2], rig[:, 3]):
-            k = np.zeros((len(length), 4, 4))
-            L = length
-            entries = {(0, 0): 12, (0, 1): 6 * L, (0, 2): -12, (0, 3): 6 * L, (1, 1): 4 * L**2,
-                       (1, 2): -6 * L, (1, 3): 2 * L**2, (2, 2): 12, (2, 3): -6 * L, (3, 3): 4 * L**2}
-            for (i, j), val in entries.items():
-                k[:, i, j] = k[:, j, i] = val * ei / L**3
-            s = 1.0 / np.sqrt(np.stack([bm, bi, bm, bi], axis=1))
-            lam = np.maximum(lam, np.linalg.eigvalsh(k * s[:, :, None] * s[:, None, :])[:, -1])
-        out.append(np.sqrt(lam))
-    return np.concatenate(out)
-
-
-def assembled_critical_frequency(mesh: StructureMesh) -> float:
-    """Largest circular frequency [rad/s] of the assembled, lumped-mass structure with every node free.
-
-    omega_max^2 is the largest eigenvalue of M^-1/2 K M^-1/2 (K of :func:`.linear.assemble_stiffness`, M the
-    lumped translational masses and rotary inertias), found by Lanczos iteration (``scipy.sparse.linalg.eigsh``;
-    a Ritz value approaches it from below, so it is raised by the solver's tolerance). Tying nodes to a hub or
-    holding them only removes freedom and cannot raise it (eigenvalue interlacing), so dt < 2 / omega_max is
-    the central-difference limit of the structure as stepped. It is below the largest element frequency
-    (:func:`critical_frequency`, Irons' bound) -- 28 % on the smoke wheel, where that bound set a step of
-    5.3e-5 s against 6.8e-5 s, and three wheel sub-steps per DEM step instead of two. Falls back to the element
-    bound if the iteration does not converge.
-    """
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla
-
-    from .linear import assemble_stiffness
-
-    bound = float(critical_frequency(mesh).max())
-    mass, inertia = mesh.lumped_mass()
-    diag = np.c_[mass, mass, mass, inertia, inertia, inertia].reshape(-1)
-    if np.any(diag <= 0.0):
-        return bound
-    scale = sp.diags(1.0 / np.sqrt(diag))
-    a = (scale @ assemble_stiffness(mesh) @ scale).tocsr()
-    tol = 1e-8
-    try:
-        # a fixed start vector: ARPACK's default is random, which moved the step by ~1e-11 between runs
-        lam = float(spla.eigsh(a, k=1, which="LA", return_eigenvectors=False, tol=tol, maxiter=20 * a.shape[0],
-                               v0=np.ones(a.shape[0]))[0])
-    except (spla.ArpackNoConvergence, spla.ArpackError):
-        return bound
-    return min(bound, math.sqrt(lam * (1.0 + 1e3 * tol)))
-
-
-def element_arrays(mesh: StructureMesh) -> dict:
-    """The facets' (tri, frame0, local0, km, kb) and beams' (ends, bframe0, blen0, rigidity) device arrays; a mesh
-    without facets or beams gets one-row placeholders the kernels take but never read."""
-    d = {}
-    if len(mesh.triangles):
-        frames, local, km, kb = shell_setup(mesh.nodes, mesh.triangles, mesh.thickness, mesh.material, mesh.drilling_penalty)
-        km_packed, kb_packed = pack_stiffness(km, kb)
-        d.update(tri=_nd(ivec3, mesh.triangles.astype(np.int32)), frame0=_nd(mat3, frames), local0=_nd(mat32, local),
-                 km=_nd(ti.f64, km_packed), kb=_nd(ti.f64, kb_packed))
-    else:
-        d.update(tri=_nd(ivec3, np.zeros((1, 3), np.int32)), frame0=_nd(mat3, np.eye(3)[None]),
-                 local0=_nd(mat32, np.zeros((1, 3, 2))), km=_nd(ti.f64, np.zeros((1, len(MEMBRANE_PACK)))),
-                 kb=_nd(ti.f64, np.zeros((1, len(BENDING_PACK)))))
-    if len(mesh.beams):
-        bframes, blen = beam_frames(mesh.nodes, mesh.beams, mesh.beam_orientation)
-        d.update(ends=_nd(ivec2, mesh.beams.astype(np.int32)), bframe0=_nd(mat3, bframes), blen0=_nd(ti.f64, blen),
-                 rigidity=_nd(vec4, beam_section_stiffness(mesh.beam_section, mesh.material)))
-    else:
-        d.update(ends=_nd(ivec2, np.array([[0, 0]], np.int32)), bframe0=_nd(mat3, np.eye(3)[None]),
-                 blen0=_nd(ti.f64, np.ones(1)), rigidity=_nd(vec4, np.zeros((1, 4))))
-    return d
-
-
-def slot_arrays(mesh: StructureMesh) -> dict:
-    """The element corners: each node's corner slots (slot_start, slot_list; facets' corners first, then beams'
-    ends) and the corners' forces and moments (slot_f, slot_m)."""
-    n = mesh.n_nodes
-    slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
-    order = np.argsort(slot_node, kind="stable")
-    start = np.zeros(n + 1, np.int32)
-    np.add.at(start, slot_node + 1, 1)
-    n_slots = len(slot_node)
-    return {"slot_start": _nd(ti.i32, np.cumsum(start).astype(np.int32)), "slot_list": _nd(ti.i32, order.astype(np.int32)),
-            "slot_f": _vec(np.zeros((n_slots, 3))), "slot_m": _vec(np.zeros((n_slots, 3)))}
-
-
-def node_arrays(mesh: StructureMesh, mass: np.ndarray, inertia: np.ndarray, tied: np.ndarray) -> dict:
-    """The nodes' state at rest in the mesh's positions, their lumped mass and inertia (1 where a node tied to the
-    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants."""
-    n = mesh.n_nodes
-    zeros = np.zeros((n, 3))
-    return {"x": _vec(mesh.nodes), "v": _vec(zeros), "rot": _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3))),
-            "w": _vec(zeros), "mass": _nd(ti.f64, np.where(mass > 0, mass, 1.0)),
-            "inertia": _nd(ti.f64, np.where(inertia > 0, inertia, 1.0)), "free": _nd(ti.i32, (~tied).astype(np.int32)),
-            "f_ext": _vec(zeros), "k_ext": _nd(ti.f64, np.zeros(n)), "x_anchor": _vec(mesh.nodes), "m_ext": _vec(zeros),
-            "f_tot": _vec(zeros), "m_tot": _vec(zeros), "peak": _nd(ti.f64, np.zeros(2))}
-
-
-def hub_arrays(mesh: StructureMesh, hub: np.ndarray, center: np.ndarray, hub_mass: float, hub_inertia) -> dict:
-    """The hub's nodes and their offsets from its ``center`` [m], its state rows (:data:`.integrator.HUB_ROWS`), its
-    rotation and its own mass [kg] and inertia [kg m^2]; without a hub, placeholders the kernels never read."""
-    if not hub.size:
-        return {"hub_nodes": _nd(ti.i32, np.zeros(1, np.int32)), "hub_offset": _vec(np.zeros((1, 3))),
-                "hub": _vec(np.zeros((itg.HUB_ROWS, 3))), "hub_rot": _nd(mat3, np.eye(3)[None]),
-                "hub_scalar": _nd(ti.f64, np.zeros(2))}
-    state = np.zeros((itg.HUB_ROWS, 3))
-    state[itg.HUB_POSITION] = center
-    state[itg.HUB_OWN_INERTIA] = np.asarray(hub_inertia, float)
-    return {"hub_nodes": _nd(ti.i32, hub.astype(np.int32)), "hub_offset": _vec(mesh.nodes[hub] - center),
-            "hub": _vec(state), "hub_rot": _nd(mat3, np.eye(3)[None]),
-            "hub_scalar": _nd(ti.f64, np.array([float(hub_mass), 0.0]))}
 
 
 class Structure:

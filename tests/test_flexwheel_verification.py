@@ -15,7 +15,8 @@ from wheelsoil.material import Material
 from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.shapes import beam_ring, cylinder_band, strip
 from wheelsoil.flexwheel.statics import relax
-from wheelsoil.flexwheel.structure import Structure, critical_frequency
+from wheelsoil.flexwheel.stability import critical_frequency
+from wheelsoil.flexwheel.structure import Structure
 
 # Sze, Liu & Lo (2004), Finite Elem. Anal. Des. 40, 1551: cantilever strip, E = 1.2e6, nu = 0, t = 0.1
 SZE = Material("Sze et al. strip", youngs_modulus=1.2e6, poisson_ratio=0.0, density=1.0)
@@ -310,7 +311,7 @@ def test_assembled_critical_step_is_the_stability_limit():
     from a state that excites every mode stay bounded at 0.98 of it and blow up at 1.03 of it; the element
     bound (Irons) lies below it."""
     from wheelsoil.flexwheel import stepper
-    from wheelsoil.flexwheel.structure import assembled_critical_frequency
+    from wheelsoil.flexwheel.stability import assembled_critical_frequency
 
     mesh, _, _ = clamped_strip(1.0, 8)
     omega = assembled_critical_frequency(mesh)
