@@ -13,9 +13,10 @@ def test_the_levels_and_their_names():
 
 
 def test_case_files_and_the_command_line_use_the_same_presets():
-    from wheelsoil.cases import case_model, cli
+    from wheelsoil.cases import case_model
+    from wheelsoil.cases.commands import prepare_bed
     from wheelsoil.cases.schema import load_case
 
-    assert cli.GRAVITY_PRESETS is GRAVITY_PRESETS and case_model.GRAVITY_PRESETS is GRAVITY_PRESETS
+    assert prepare_bed.GRAVITY_PRESETS is GRAVITY_PRESETS and case_model.GRAVITY_PRESETS is GRAVITY_PRESETS
     case = load_case("smoke-moon-steer")
     assert -case.soil.gravity_vector[2] == pytest.approx(MOON_GRAVITY)
