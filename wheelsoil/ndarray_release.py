@@ -3,7 +3,7 @@
 In Taichi 1.7 only ``ScalarNdarray`` frees its device memory in ``__del__``; ``VectorNdarray`` and
 ``MatrixNdarray`` never do (taichi-dev/taichi issue #8763, fix proposed in PR #8764: move ``__del__`` to the
 ``Ndarray`` base class). Every reallocation of a vector ndarray therefore leaks it: on the CPU an 8 MB
-``ti.Vector.ndarray(3, f64, (21000, 16))`` created and dropped 60 times grew the process by 464 MiB. The CMU twin
+``ti.Vector.ndarray(3, f64, (21000, 16))`` created and dropped 60 times grew the process by 463-475 MiB (two runs). The CMU twin
 reallocates its per-sphere contact histories at every shift of its moving soil patch (about nine a second when the
 wheel is dragged), and a dragged run's resident memory grew to 3.4 GB by t = 10 s.
 
