@@ -52,21 +52,30 @@ class TorsionLoadTest:
         return out
 
 
-def check_options(points: int, max_load_factor: float, max_twist_deg: float | None) -> None:
-    """The load tests' settings, checked before any of them runs (``max_twist_deg`` None: no torsion test)."""
+def _check_plate(points: int, max_load_factor: float) -> None:
     if points < 2:
         raise WheelsoilInputError(f"--points={points} must be >= 2")
     if not max_load_factor > 0:
         raise WheelsoilInputError(f"--max-load-factor={max_load_factor} must be > 0")
-    if max_twist_deg is not None and not 0 < max_twist_deg <= 45:
+
+
+def _check_twist(max_twist_deg: float) -> None:
+    if not 0 < max_twist_deg <= 45:
         raise WheelsoilInputError(f"--max-twist={max_twist_deg} deg must lie in (0, 45]")
+
+
+def check_options(points: int, max_load_factor: float, max_twist_deg: float | None) -> None:
+    """The load tests' settings, checked before any of them runs (``max_twist_deg`` None: no torsion test)."""
+    _check_plate(points, max_load_factor)
+    if max_twist_deg is not None:
+        _check_twist(max_twist_deg)
 
 
 def radial_load_test(geometry, points: int, max_load_factor: float, progress=None) -> RadialLoadTest:
     """Point-load stiffness at five angles over one spoke pitch, then ``points`` plate deflections up to
     ``max_load_factor`` times the nominal load at the softest angle's rate (at most a fifth of the radius), over the
     spoke and midway between spokes."""
-    check_options(points, max_load_factor, None)
+    _check_plate(points, max_load_factor)
     report = progress or (lambda phase, done, total: None)
     pitch = geometry.spoke_pitch
     angles = np.linspace(0.0, pitch, 5)
@@ -97,7 +106,7 @@ def write_load_csv(test: RadialLoadTest, path) -> None:
 def torsion_load_test(geometry, mesh, max_twist_deg: float, corotational: bool, progress=None) -> TorsionLoadTest:
     """The linear torsional stiffness with the tread clamped and with the torque on the tread, and (``corotational``)
     the corotational curves at +-1 deg, +-max/2 and +-max of twist."""
-    check_options(2, 1.0, max_twist_deg)
+    _check_twist(max_twist_deg)
     report = progress or (lambda phase, done, total: None)
     linear = {hold: torsion_test(geometry, method="linear", hold=hold) for hold in ("tread", "free")}
     curves = list(linear.values())

@@ -29,7 +29,7 @@ JUDGED_RESPONSES = ("drawbar_pull", "lateral_force")
 
 
 @dataclass(frozen=True)
-class TrialResiduals:
+class TrialValues:
     """One measured trial with the baseline's and the candidate's value of each response (NaN where not run)."""
 
     row: int  # index into the measured data
@@ -53,7 +53,7 @@ class CandidateVerdict:
     replica_spread: float | None  # RMS-pooled std of the normalised simulated responses over the replicas
     replicas: int
     verdict: str  # "accepted", "not accepted", "provisional: ...", "not judged: ..."
-    trials: list[TrialResiduals] = field(default_factory=list)
+    trials: list[TrialValues] = field(default_factory=list)
     scales: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -97,7 +97,7 @@ def judge_candidate(data: Measurements, baseline: Measurements, candidate: Measu
     trials = []
     for k in sorted(set(base) | set(cand)):
         nan = {q: float("nan") for q in responses}
-        trials.append(TrialResiduals(
+        trials.append(TrialValues(
             row=k, slip_angle=float(data.slip_angle[k]), slip=float(data.slip[k]), load=float(data.load[k]),
             held_out=bool(mask[k]), measured={q: float(data.responses[q][k]) for q in responses},
             baseline=base.get(k, nan), candidate=cand.get(k, nan)))

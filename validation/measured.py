@@ -151,14 +151,28 @@ class Measurements:
     def __len__(self) -> int:
         return len(self.slip)
 
+    #: The per-row condition arrays after ``name``, in the constructor's order.
+    ROW_FIELDS = ("slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")
+
     def select(self, mask) -> "Measurements":
         mask = np.asarray(mask)
         pick = lambda a: a[mask]  # noqa: E731
-        return Measurements(self.name, *(pick(getattr(self, k)) for k in (
-            "slip", "slip_angle", "load", "gravity", "radius", "width", "grouser_height", "grouser_count", "group")),
+        return Measurements(self.name, *(pick(getattr(self, k)) for k in self.ROW_FIELDS),
             responses={k: pick(v) for k, v in self.responses.items()}, std={k: pick(v) for k, v in self.std.items()},
             notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes),
             travel_slip=pick(self.travel_slip))
+
+    @classmethod
+    def concat(cls, name: str, parts) -> "Measurements":
+        """The rows of ``parts`` (Measurements of the same responses) one after another, as dataset ``name``; the
+        standard deviations where every part gives them."""
+        parts = list(parts)
+        cat = lambda key: np.concatenate([np.asarray(getattr(p, key)) for p in parts])  # noqa: E731
+        return cls(name, *(cat(k) for k in cls.ROW_FIELDS),
+                   responses={q: np.concatenate([p.responses[q] for p in parts]) for q in parts[0].responses},
+                   std={q: np.concatenate([p.std[q] for p in parts]) for q in parts[0].std if all(q in p.std for p in parts)},
+                   notes=parts[0].notes, sinkage_relative=parts[0].sinkage_relative, passes=cat("passes"),
+                   travel_slip=cat("travel_slip"))
 
     def kinds(self) -> np.ndarray:
         """Each row's kind of motion (:data:`ROW_KINDS`): "dragged" (the wheel does not turn, travel slip -1),
