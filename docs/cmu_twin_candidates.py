@@ -42,7 +42,7 @@ def replicas(runs: Path, data):
     """The twin's runs of the replicas' condition: the subset's (repeat 1) and the replica sweep's."""
     from wheelsoil.cases.cmu_sweep import REPLICA_CONDITION
     from wheelsoil.validation.compare import match_conditions
-    from wheelsoil.validation.measured import Measurements
+    from wheelsoil.validation.candidate_test import concat_runs
 
     wheel, angle, slip = REPLICA_CONDITION
     at = (data.grouser_height > 0) == (wheel == "grouser")
@@ -55,7 +55,7 @@ def replicas(runs: Path, data):
         pairs, _ = match_conditions(data.select(at), sim)
         if len(pairs):
             parts.append(sim.select(np.unique(pairs[:, 1])))
-    return Measurements.concat("replicas", parts) if parts else None
+    return concat_runs("replicas", parts) if parts else None
 
 
 def report(name: str, verdict, why: str) -> str:

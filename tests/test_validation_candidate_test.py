@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from wheelsoil.validation.calibration import response_scales
-from wheelsoil.validation.candidate_test import judge_candidate, replica_spread
+from wheelsoil.validation.candidate_test import concat_runs, judge_candidate, replica_spread
+from wheelsoil.validation.measured import Measurements
 from wheelsoil.validation.synthetic import conditions, synthetic_measurements
 
 Q = ("drawbar_pull", "lateral_force")
@@ -79,3 +80,16 @@ def test_the_replica_spread_pools_the_responses():
     assert replica_spread(reps, {"drawbar_pull": 2.0, "lateral_force": 1.0}, Q) == pytest.approx(
         np.sqrt(0.5 * (np.sqrt(2.0) / 2.0) ** 2), rel=1e-12)
     assert replica_spread(d, {"drawbar_pull": 2.0, "lateral_force": 1.0}, Q) is None
+
+
+def test_concat_runs_puts_the_parts_rows_one_after_another(data):
+    a = data.slip_angle == 0.0
+    runs = replace(data, std={"drawbar_pull": np.arange(len(data), dtype=float)})
+    joined = concat_runs("both", [runs.select(a), runs.select(~a)])
+    order = runs.select(np.r_[np.flatnonzero(a), np.flatnonzero(~a)])
+    assert joined.name == "both" and len(joined) == len(data)
+    for key in Measurements.ROW_FIELDS + ("passes", "travel_slip"):
+        np.testing.assert_array_equal(getattr(joined, key), getattr(order, key), err_msg=key)
+    for q in data.responses:
+        np.testing.assert_array_equal(joined.responses[q], order.responses[q])
+    np.testing.assert_array_equal(joined.std["drawbar_pull"], order.std["drawbar_pull"])

@@ -147,19 +147,3 @@ def test_residuals_are_summarised_by_kind_of_motion_and_angle(measured_dir):
     driving = next(r for r in rows if r["group"] == "driving")
     assert driving["final"]["slip_spearman"] == pytest.approx(1.0)
 
-
-def test_concat_puts_the_parts_rows_one_after_another(measured_dir):
-    from wheelsoil.validation.measured import Measurements
-
-    data = load_cmu_trials(os.path.join(measured_dir, "cmu_3d_terramechanics"))
-    a = data.slip_angle == 0.0
-    joined = Measurements.concat("both", [data.select(a), data.select(~a)])
-    order = data.select(np.r_[np.flatnonzero(a), np.flatnonzero(~a)])
-    assert joined.name == "both" and len(joined) == len(data)
-    for key in Measurements.ROW_FIELDS + ("passes", "travel_slip"):
-        np.testing.assert_array_equal(getattr(joined, key), getattr(order, key), err_msg=key)
-    for q in data.responses:
-        np.testing.assert_array_equal(joined.responses[q], order.responses[q])
-    assert set(joined.std) == set(data.std)
-    for q in data.std:
-        np.testing.assert_array_equal(joined.std[q], order.std[q])

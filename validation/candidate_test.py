@@ -84,6 +84,19 @@ def replica_spread(replicas: Measurements | None, scales: dict[str, float], resp
     return float(np.sqrt(np.mean(var)))
 
 
+def concat_runs(name: str, parts) -> Measurements:
+    """The rows of ``parts`` (runs of the same responses, e.g. replicas gathered from several sweeps) one after
+    another, as dataset ``name``; the standard deviations where every part gives them."""
+    parts = list(parts)
+    cat = lambda key: np.concatenate([np.asarray(getattr(p, key)) for p in parts])  # noqa: E731
+    return Measurements(name, *(cat(k) for k in Measurements.ROW_FIELDS),
+                        responses={q: np.concatenate([p.responses[q] for p in parts]) for q in parts[0].responses},
+                        std={q: np.concatenate([p.std[q] for p in parts]) for q in parts[0].std
+                             if all(q in p.std for p in parts)},
+                        notes=parts[0].notes, sinkage_relative=parts[0].sinkage_relative, passes=cat("passes"),
+                        travel_slip=cat("travel_slip"))
+
+
 def judge_candidate(data: Measurements, baseline: Measurements, candidate: Measurements, held_out,
                     replicas: Measurements | None = None, responses=JUDGED_RESPONSES) -> CandidateVerdict:
     """Judge ``candidate`` against ``baseline`` on the measured rows where ``held_out`` (a boolean mask over

@@ -162,18 +162,6 @@ class Measurements:
             notes=self.notes, sinkage_relative=self.sinkage_relative, passes=pick(self.passes),
             travel_slip=pick(self.travel_slip))
 
-    @classmethod
-    def concat(cls, name: str, parts) -> "Measurements":
-        """The rows of ``parts`` (Measurements of the same responses) one after another, as dataset ``name``; the
-        standard deviations where every part gives them."""
-        parts = list(parts)
-        cat = lambda key: np.concatenate([np.asarray(getattr(p, key)) for p in parts])  # noqa: E731
-        return cls(name, *(cat(k) for k in cls.ROW_FIELDS),
-                   responses={q: np.concatenate([p.responses[q] for p in parts]) for q in parts[0].responses},
-                   std={q: np.concatenate([p.std[q] for p in parts]) for q in parts[0].std if all(q in p.std for p in parts)},
-                   notes=parts[0].notes, sinkage_relative=parts[0].sinkage_relative, passes=cat("passes"),
-                   travel_slip=cat("travel_slip"))
-
     def kinds(self) -> np.ndarray:
         """Each row's kind of motion (:data:`ROW_KINDS`): "dragged" (the wheel does not turn, travel slip -1),
         "braking" (it turns slower than it travels, -1 < travel slip < :data:`FREE_ROLLING_SLIP`) or "driving"
