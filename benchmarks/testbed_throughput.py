@@ -66,7 +66,8 @@ def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS[
     calibrated sand, issue 37 item 2)."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
-    from wheelsoil.coupling.testbed import Testbed, soil_headroom
+    from wheelsoil.coupling.testbed import Testbed
+    from wheelsoil.coupling.rig import soil_headroom
     from wheelsoil.granular import prepare_bed
 
     case = load_case(preset, [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from wheelsoil.coupling.testbed import TestbedSpec
+from wheelsoil.coupling.rig import TestbedSpec
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, preset
-from wheelsoil.granular.bed import BedSpec
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import seed004, smoke
 

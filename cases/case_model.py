@@ -13,10 +13,10 @@ from typing import Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
-from wheelsoil.coupling.testbed import TestbedSpec
+from wheelsoil.coupling.rig import TestbedSpec
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
-from wheelsoil.granular.bed import BedSpec
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.gravity import GRAVITY_PRESETS
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import smoke

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.granular.bed import estimated_particles
+from wheelsoil.granular.bed_spec import estimated_particles
 
 from . import build
 from .results import load_result

@@ -27,7 +27,7 @@ import numpy as np
 from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import estimated_elements
-from wheelsoil.granular.bed import estimated_particles
+from wheelsoil.granular.bed_spec import estimated_particles
 from wheelsoil.provenance import atomic_output, provenance, writable_folder
 
 from . import build

@@ -33,7 +33,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from wheelsoil.coupling.testbed import check_fits
+from wheelsoil.coupling.rig import check_fits
 from wheelsoil.errors import WheelsoilInputError
 
 from . import build

@@ -83,7 +83,8 @@ def candidate_name(mu: float, mu_r: float, pour: float, law: str = "cdt") -> str
 
 def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False, law: str = "cdt") -> dict:
     from wheelsoil import soillab
-    from wheelsoil.granular.bed import BedSpec, prepare_bed
+    from wheelsoil.granular.bed import prepare_bed
+    from wheelsoil.granular.bed_spec import BedSpec
     from wheelsoil.material import Material, PairProperties
     from wheelsoil.parameters import cmu_k10, soil_lab
 

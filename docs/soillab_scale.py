@@ -37,7 +37,7 @@ TOLERANCE = 0.10
 
 def one_run(scale: float, seed: int, cache) -> dict:
     from wheelsoil import soillab
-    from wheelsoil.granular.bed import BedSpec
+    from wheelsoil.granular.bed_spec import BedSpec
     from wheelsoil.parameters import soil_lab
 
     start = time.perf_counter()

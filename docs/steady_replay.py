@@ -26,7 +26,8 @@ import numpy as np
 from wheelsoil.cases import build
 from wheelsoil.cases.schema import load_case
 from wheelsoil.coupling.steady import confirm_steady
-from wheelsoil.coupling.testbed import batches_per_period, detect_from_rows, statistics_pitch
+from wheelsoil.coupling.testbed import detect_from_rows
+from wheelsoil.coupling.rig import batches_per_period, statistics_pitch
 
 
 def read_series(path: Path) -> dict:

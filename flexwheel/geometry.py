@@ -25,7 +25,7 @@ from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.parameters import cmu_k10, exomars, seed004
 from wheelsoil.ranges import Range, check_ranges, non_negative, positive
 
-from .beam import rectangular_section
+from .beam_section import rectangular_section
 from .material import SEED004_WHEEL, Material
 from .mesh import StructureMesh
 from .shapes import grid_triangles

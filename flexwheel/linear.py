@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .beam import beam_frames, beam_section_stiffness
+from .beam_section import beam_frames, beam_section_stiffness
 from .mesh import StructureMesh
 from .shell import shell_setup
 

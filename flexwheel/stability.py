@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .beam import beam_section_stiffness
+from .beam_section import beam_section_stiffness
 from .mesh import StructureMesh
 from .shell import shell_setup
 

@@ -10,7 +10,7 @@ from wheelsoil.taichi_types import ivec2, ivec3, mat3, mat32, vec3, vec4
 from wheelsoil.taichi_types import to_ndarray as _nd
 
 from . import integrator as itg
-from .beam import beam_frames, beam_section_stiffness
+from .beam_section import beam_frames, beam_section_stiffness
 from .mesh import StructureMesh
 from .shell import BENDING_PACK, MEMBRANE_PACK, pack_stiffness, shell_setup
 

@@ -10,7 +10,9 @@ Public API::
     column_order             particle order for memory locality (prepared beds use it)
 """
 
-from .bed import Bed, BedNotSettledError, BedSpec, load_bed, prepare_bed
+from importlib import import_module
+
+from .bed_spec import BedSpec
 from .errors import CapacityError, SimulationUnstableError, WheelsoilInputError
 from .materials import (
     LUNAR_SOIL_SIMULANT,
@@ -26,9 +28,21 @@ from .materials import (
     restitution_damping_ratio,
 )
 from .ordering import column_order
-from .runtime import init
-from .scene import DeviceState, Interaction, Scene, Wall
 from .timestep import TimeStepEstimate, estimate_time_step
+
+#: The engine's names, imported on first use (PEP 562) so that the plain descriptions above (a bed's spec, the
+#: materials, the time step) load without Taichi: a case file is checked before the engine starts.
+_ENGINE = {"Bed": ".bed", "BedNotSettledError": ".bed", "load_bed": ".bed", "prepare_bed": ".bed", "init": ".runtime",
+           "DeviceState": ".scene", "Interaction": ".scene", "Scene": ".scene", "Wall": ".scene"}
+
+
+def __getattr__(name: str):
+    if name in _ENGINE:
+        value = getattr(import_module(_ENGINE[name], __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "Bed",

@@ -19,7 +19,8 @@ import numpy as np
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, from_parameters
-from wheelsoil.granular.bed import Bed, BedSpec, prepare_bed
+from wheelsoil.granular.bed import Bed, prepare_bed
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.granular.materials import STEEL, PairProperties
 from wheelsoil.parameters import cmu_k10
 

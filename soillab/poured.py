@@ -13,7 +13,9 @@ import dataclasses
 import time
 from dataclasses import dataclass
 
-from wheelsoil.granular.bed import BedSpec, prepare_bed
+from wheelsoil.granular.bed import prepare_bed
+
+from wheelsoil.granular.bed_spec import BedSpec
 
 from .specs import check_seeds, mean_and_spread
 

@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wheelsoil.granular.bed import Bed, BedSpec, prepare_bed
+from wheelsoil.granular.bed import Bed, prepare_bed
+
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.granular.scene import Scene
 
 from .specs import ReposeSpec, check_resolution, mean_and_spread

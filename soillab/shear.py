@@ -27,7 +27,8 @@ import numpy as np
 from scipy import stats
 
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.granular.bed import Bed, BedSpec, prepare_bed
+from wheelsoil.granular.bed import Bed, prepare_bed
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.granular.materials import STEEL
 from wheelsoil.granular.scene import Scene
 

@@ -150,7 +150,8 @@ def test_column_order_groups_spheres_into_columns():
 
 @pytest.mark.parametrize("periodic", [False, True])
 def test_fill_particle_estimate_is_the_lattice_count(periodic):
-    from wheelsoil.granular.bed import fill_particles, initial_packing
+    from wheelsoil.granular.bed import initial_packing
+    from wheelsoil.granular.bed_spec import fill_particles
 
     spec = BedSpec(length=0.6, width=0.25, depth=0.05, diameter_min=0.010, diameter_max=0.015, periodic=periodic)
     positions, _, _ = initial_packing(spec)
@@ -162,7 +163,7 @@ def test_a_bed_past_the_machine_memory_is_refused_before_any_work_naming_the_key
     end in MemoryError) is refused by the estimate alone, without allocating; the message names the keys."""
     import time
 
-    from wheelsoil.granular.bed import BYTES_PER_PARTICLE, check_memory, fill_particles
+    from wheelsoil.granular.bed_spec import BYTES_PER_PARTICLE, check_memory, fill_particles
 
     spec = BedSpec(length=2.0, width=0.9, depth=0.2, diameter_min=0.001, diameter_max=0.0015, periodic=False)
     t0 = time.perf_counter()

@@ -10,7 +10,7 @@ import pytest
 from wheelsoil.cases.build import specs
 from wheelsoil.cases.schema import CaseError, load_case
 from wheelsoil.coupling.kinematics import longitudinal_slip
-from wheelsoil.coupling.testbed import carriage_speed
+from wheelsoil.coupling.rig import carriage_speed
 from wheelsoil.parameters import cmu_k10
 
 

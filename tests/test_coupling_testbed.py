@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from wheelsoil.coupling.surface import ContactSurface
-from wheelsoil.coupling.testbed import Testbed, TestbedSpec
+from wheelsoil.coupling.testbed import Testbed
+from wheelsoil.coupling.rig import TestbedSpec
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.flexwheel.material import SEED004_WHEEL
@@ -163,7 +164,7 @@ def test_bad_rig_settings_name_the_key_value_and_range(change, key):
 ])
 def test_the_carriage_and_hub_give_the_commanded_slip_against_the_named_speed(slip, beta, reference, spin, speed):
     from wheelsoil.coupling.kinematics import longitudinal_slip, slip_angle_deg
-    from wheelsoil.coupling.testbed import carriage_speed
+    from wheelsoil.coupling.rig import carriage_speed
 
     spec = replace(MINI_RUN, slip=slip, slip_angle=beta, slip_speed=reference)
     hub_spin, along_bin = carriage_speed(spec, MINI_WHEEL.radius)
@@ -237,7 +238,7 @@ def test_the_soil_domain_holds_grains_carried_over_the_wheel_top(steering_run):
 def test_the_wheel_period_maps_grousers_and_spokes_onto_themselves(grousers, spokes, rows, period, batch):
     """wheel_period is 360 deg / gcd(grousers, spokes around); the statistics' batch is the period when one
     pitch is a multiple of the other, else the grouser pitch, and always divides the period."""
-    from wheelsoil.coupling.testbed import batches_per_period, statistics_pitch, wheel_period
+    from wheelsoil.coupling.rig import batches_per_period, statistics_pitch, wheel_period
     from wheelsoil.flexwheel.geometry import SpokeRow
 
     n = len(rows)

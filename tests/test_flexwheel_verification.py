@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import solve_bvp, trapezoid
 from scipy.spatial.transform import Rotation
 
-from wheelsoil.flexwheel.beam import rectangular_section
+from wheelsoil.flexwheel.beam_section import rectangular_section
 from wheelsoil.flexwheel.linear import assemble_stiffness
 from wheelsoil.material import Material
 from wheelsoil.flexwheel.mesh import StructureMesh

@@ -16,10 +16,10 @@ from wheelsoil.cases import build
 from wheelsoil.cases.cli import build_parser
 from wheelsoil.cases.commands.prepare_bed import spec_from_args as cli_bed_spec
 from wheelsoil.cases.schema import SECTIONS, CaseError, CaseFile, validate_case
-from wheelsoil.coupling.testbed import TestbedSpec
+from wheelsoil.coupling.rig import TestbedSpec
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import LUNAR_ROVER, WheelGeometry
-from wheelsoil.granular.bed import BedSpec
+from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import seed004
 from wheelsoil.ranges import Range

@@ -75,7 +75,7 @@ def add_parser(sub) -> None:
 
 
 def _bed_spec(args, box: dict, seed: int):
-    from wheelsoil.granular.bed import BedSpec
+    from wheelsoil.granular.bed_spec import BedSpec
     from wheelsoil.material import Material
 
     material = Material("soil-lab particles", youngs_modulus=args.youngs_modulus, poisson_ratio=args.poisson_ratio,
