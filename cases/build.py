@@ -9,17 +9,22 @@ parameter set (:mod:`wheelsoil.parameters.smoke`):
 * :func:`testbed_spec` -- ``[test]``, ``[contact]``, ``[output]``, ``soil.time_step`` and the wheel's
   ``rigid``/``damping`` -> :class:`~wheelsoil.coupling.testbed.TestbedSpec`.
 
-The schema (:func:`~wheelsoil.cases.schema.validate_case`) calls :func:`specs` when it validates a case, so the solver's cross-checks (particles against the
-bin, the wheel against the bin, the drive against a static bin) run before any work.
+:func:`plan` builds the three once, runs the solver's cross-checks on them (particles against the bin and the
+machine's memory, the wheel against the bin, the drive against a static bin: :func:`~wheelsoil.coupling.rig.check_fits`)
+and adds the run's size (particles, elements, output bytes): the :class:`RunPlan` that
+:func:`~wheelsoil.cases.run.run_case` hands to the bed's preparation and the testbed, so nothing downstream builds or
+checks a spec again. The schema (:func:`~wheelsoil.cases.schema.validate_case`) makes a plan when it validates a case,
+so those checks run before any work; it keeps the case, not the plan (a case is a plain value that sweeps copy and
+change, and its plan is made again, in microseconds, where it runs).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
-from wheelsoil.coupling.rig import TestbedSpec
-from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, preset
-from wheelsoil.granular.bed_spec import BedSpec
+from wheelsoil.coupling.rig import RigPlan, TestbedSpec, plan_rig
+from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, estimated_elements, preset
+from wheelsoil.granular.bed_spec import BedSpec, estimated_particles
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import seed004, smoke
 
@@ -82,3 +87,50 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
 def specs(case: CaseFile) -> tuple[BedSpec, WheelGeometry, TestbedSpec]:
     """(bed, wheel, test) of a case: what :class:`~wheelsoil.coupling.testbed.Testbed` is made from."""
     return bed_spec(case), wheel_geometry(case), testbed_spec(case)
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """A case's run, built and checked once (:func:`plan`).
+
+    rig: the bed spec, wheel and rig settings, checked against each other, and the hub's start position.
+    particles: spheres in the levelled bed (estimate, :func:`~wheelsoil.granular.bed_spec.estimated_particles`).
+    elements: the wheel's elements (estimate, :func:`~wheelsoil.flexwheel.geometry.estimated_elements`).
+    output_bytes: upper estimate of the run folder's size [bytes] (:func:`output_bytes`).
+    """
+
+    rig: RigPlan
+    particles: int
+    elements: int
+    output_bytes: int
+
+    @property
+    def bed(self) -> BedSpec:
+        return self.rig.bed
+
+    @property
+    def wheel(self) -> WheelGeometry:
+        return self.rig.wheel
+
+    @property
+    def test(self) -> TestbedSpec:
+        return self.rig.test
+
+
+def output_bytes(case: CaseFile, particles: int, elements: int) -> int:
+    """Upper estimate of a run's files [bytes]: its frames (at most one per sample; per particle position,
+    velocity and radius, per wheel element about a node's position and deformation, 8 bytes each) over the
+    longest run (lowering allowed 2 s, settle, spin-up, the whole drive), plus two checkpoints."""
+    t, o = case.test, case.output
+    total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
+    frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
+    per_frame = particles * 7 * 8 + elements * 6 * 8
+    return frames * per_frame + 2 * particles * 30 * 8
+
+
+def plan(case: CaseFile) -> RunPlan:
+    """The case's :class:`RunPlan`: its specs built once and checked against each other and the machine; errors
+    (:class:`~wheelsoil.errors.WheelsoilInputError`) name the case keys and values."""
+    rig = plan_rig(*specs(case))
+    particles, elements = estimated_particles(rig.bed), estimated_elements(rig.wheel)
+    return RunPlan(rig, particles, elements, output_bytes(case, particles, elements))

@@ -26,8 +26,6 @@ import numpy as np
 
 from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
-from wheelsoil.flexwheel.geometry import estimated_elements
-from wheelsoil.granular.bed_spec import estimated_particles
 from wheelsoil.provenance import atomic_output, provenance, writable_folder
 
 from . import build
@@ -84,28 +82,16 @@ def load_checkpoint(path: Path) -> tuple[dict, dict]:
 
 
 # -------------------------------------------------------------------- the run
-def output_bytes(case: CaseFile) -> int:
-    """Upper estimate of a run's files [bytes]: its frames (at most one per sample; per particle position,
-    velocity and radius, per wheel element about a node's position and deformation, 8 bytes each) over the
-    longest run (lowering allowed 2 s, settle, spin-up, the whole drive), plus two checkpoints."""
-    t = case.test
-    total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
-    o = case.output
-    frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
-    particles = estimated_particles(build.bed_spec(case))
-    per_frame = particles * 7 * 8 + estimated_elements(build.wheel_geometry(case)) * 6 * 8
-    return frames * per_frame + 2 * particles * 30 * 8
-
-
 def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume: bool = False,
              restart: bool = False, progress: bool = False, console=None,
-             bed_cache: str | Path | None = None) -> RunOutcome:
+             bed_cache: str | Path | None = None, plan: build.RunPlan | None = None) -> RunOutcome:
     """Run ``case`` and write its folder ``out`` (see the module docstring).
 
     ``resume``: continue from ``out``'s checkpoint (an error names what is missing or different).
     ``restart``: discard the checkpoint of an unfinished run in ``out`` and start afresh; without it
     (or ``resume``) such a folder is refused, so that no progress is thrown away by accident.
     ``bed_cache``: the bed cache folder (default ``WHEELSOIL_CACHE`` or ``~/.cache/wheelsoil``).
+    ``plan``: the case's :class:`~wheelsoil.cases.build.RunPlan` if the caller made it (default: made here, once).
     Raises :class:`~wheelsoil.errors.WheelsoilInputError` for bad input and
     :class:`~wheelsoil.errors.SimulationUnstableError` when the run blows up; a run that fails after
     a checkpoint keeps its partial files, so that ``resume=True`` can continue it.
@@ -114,7 +100,8 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     from wheelsoil.granular import prepare_bed
 
     say = console.print if console is not None else (lambda *a, **k: None)
-    out = writable_folder(out, "--out", need_bytes=output_bytes(case))
+    plan = plan or build.plan(case)
+    out = writable_folder(out, "--out", need_bytes=plan.output_bytes)
     result_path = out / RESULT_NAME
     ckpt_path = out / CHECKPOINT_NAME
     case_hash = case.case_hash()
@@ -140,10 +127,10 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
         ckpt_path.unlink(missing_ok=True)
         partial_path(result_path).unlink(missing_ok=True)
 
-    bed = prepare_bed(build.bed_spec(case), cache_dir=bed_cache, progress=progress, arch=arch)
+    bed = prepare_bed(plan.bed, cache_dir=bed_cache, progress=progress, arch=arch)
     say(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
-    spec = build.testbed_spec(case)
-    bench = Testbed(bed, build.wheel_geometry(case), spec, arch=arch)
+    spec = plan.test
+    bench = Testbed(bed, plan=plan.rig, arch=arch)
     say(f"wheel {case.wheel.preset}: {bench.mesh.n_elements} elements, {bench.wheel_mass:.1f} kg, "
         f"{'rigid' if spec.rigid else 'flexible'}; DEM step {bench.dt:.3g} s; slip {spec.slip:g}, "
         f"steering {spec.slip_angle:g} deg, W = {spec.load:g} N")

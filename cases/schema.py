@@ -33,7 +33,6 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from wheelsoil.coupling.rig import check_fits
 from wheelsoil.errors import WheelsoilInputError
 
 from . import build
@@ -161,7 +160,7 @@ def validate_case(data: dict, source: str, *, default_name: str | None = None) -
                                      f"({'the last frame only' if key == 'frame_interval' else 'none'}) or at least "
                                      f"{o.sample_interval:g} s"])
     try:  # the solver's own cross-checks (particle sizes against the bin, wheel proportions, the drive, ...)
-        check_fits(*build.specs(case))
+        build.plan(case)
     except WheelsoilInputError as exc:
         raise CaseError(source, [str(exc)]) from None
     return case

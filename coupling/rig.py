@@ -218,6 +218,22 @@ def batches_per_period(wheel: WheelGeometry) -> int:
     return int(round(wheel_period(wheel) / statistics_pitch(wheel)))
 
 
+@dataclass(frozen=True)
+class RigPlan:
+    """A rig checked against its bed and wheel (:func:`plan_rig`): what :class:`~.testbed.Testbed` is made from
+    without checking it again. ``start_x``: the hub's start position along the bin [m]."""
+
+    bed: BedSpec
+    wheel: WheelGeometry
+    test: TestbedSpec
+    start_x: float
+
+
+def plan_rig(bed: BedSpec, wheel: WheelGeometry, test: TestbedSpec) -> RigPlan:
+    """The rig of ``test`` for ``wheel`` on a bed of ``bed``, checked once (:func:`check_fits`)."""
+    return RigPlan(bed, wheel, test, check_fits(bed, wheel, test))
+
+
 def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     """Check, before any bed is prepared, that the bed and the wheel mesh fit the machine's memory, that the
     time step and the load are ones the contact model can take, that the wheel fits the bin and that the bin

@@ -68,7 +68,7 @@ from wheelsoil.granular.bed import Bed
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg
 from .patch import MovingPatch
-from .rig import TestbedSpec, batches_per_period, carriage_speed, check_fits, soil_headroom, statistics_pitch
+from .rig import RigPlan, TestbedSpec, batches_per_period, carriage_speed, plan_rig, soil_headroom, statistics_pitch
 from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
 
 #: Series recorded at every sample, with units.
@@ -139,21 +139,32 @@ class Testbed:
     wheel: the wheel geometry (e.g. ``flexwheel.geometry.LUNAR_ROVER.with_element_size(0.05)``).
     spec: the rig settings (:class:`TestbedSpec`).
     arch: Taichi backend.
+    plan: instead of ``wheel`` and ``spec``, a rig already checked for this bed (:func:`~.rig.plan_rig`; a case's
+        run plan carries one), so the fit checks run once.
     """
 
     __test__ = False
 
-    def __init__(self, bed: Bed | str | Path, wheel: WheelGeometry, spec: TestbedSpec | None = None, *,
-                 arch: str | None = None) -> None:
+    def __init__(self, bed: Bed | str | Path, wheel: WheelGeometry | None = None, spec: TestbedSpec | None = None, *,
+                 arch: str | None = None, plan: RigPlan | None = None) -> None:
         if isinstance(bed, (str, Path)):
             if not Path(bed).is_file():
                 raise WheelsoilInputError(f"bed file {str(bed)!r} does not exist; prepare it with 'wheelsoil prepare-bed'")
             bed = Bed.load(bed)
         if not isinstance(bed, Bed):
             raise WheelsoilInputError(f"bed must be a Bed or a bed file path, got {type(bed).__name__}")
-        if not isinstance(wheel, WheelGeometry):
+        if plan is not None:  # checked already (plan_rig): the plan's wheel and rig, on the bed it was made for
+            if wheel is not None or spec is not None:
+                raise WheelsoilInputError("give the testbed either a plan or a wheel and spec, not both")
+            if plan.bed != bed.spec:
+                raise WheelsoilInputError("the bed is not the one the plan was made for: prepare the plan's bed "
+                                          "(prepare_bed(plan.bed)) or plan for this one (plan_rig(bed.spec, ...))")
+            wheel, spec = plan.wheel, plan.test
+        elif not isinstance(wheel, WheelGeometry):
             raise WheelsoilInputError(f"wheel must be a WheelGeometry, got {type(wheel).__name__}")
         spec = spec or TestbedSpec()
+        if plan is None:
+            plan = plan_rig(bed.spec, wheel, spec)
         self.bed, self.wheel, self.spec = bed, wheel, spec
         bs = bed.spec
         beta = math.radians(spec.slip_angle)
@@ -168,7 +179,7 @@ class Testbed:
         #: spin) the angle it would roll through at its travel speed
         self.batch_rate = batch_rate(spec.slip, spec.angular_velocity, wheel.radius)
         self.periodic = bool(bs.periodic)
-        start_x = check_fits(bs, wheel, spec)
+        start_x = plan.start_x
         if self.periodic:
             self.patch = MovingPatch(bed, wheel_reach=outer, shift=spec.patch_shift or 0.2 * wheel.radius)
             self.patch.check_start(start_x)

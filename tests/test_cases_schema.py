@@ -119,8 +119,10 @@ def test_every_preset_round_trips_through_its_resolved_toml():
         text = case_to_toml(case)
         assert case_from_toml(text, name) == case, name
         assert case.name == name
-        # the solver's objects build from every preset
-        build.bed_spec(case), build.wheel_geometry(case), build.testbed_spec(case)
+        # the solver's objects build from every preset, once, into the run plan
+        plan = build.plan(case)
+        assert (plan.bed, plan.wheel, plan.test) == build.specs(case)
+        assert plan.particles > 0 and plan.elements > 0 and plan.output_bytes > plan.particles
 
 
 def test_case_hash_ignores_the_name_and_follows_the_physics():

@@ -7,7 +7,7 @@ import pytest
 
 from wheelsoil.coupling.surface import ContactSurface
 from wheelsoil.coupling.testbed import Testbed
-from wheelsoil.coupling.rig import TestbedSpec
+from wheelsoil.coupling.rig import TestbedSpec, check_fits, plan_rig
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.flexwheel.material import SEED004_WHEEL
@@ -186,6 +186,20 @@ def test_wheel_wider_than_the_bin_short_bin_and_missing_bed_are_refused(mini_bed
         Testbed(mini_bed, MINI_WHEEL, replace(MINI_RUN, drive_time=5.0))
     with pytest.raises(WheelsoilInputError, match="does not exist"):
         Testbed(tmp_path / "missing.h5", MINI_WHEEL, MINI_RUN)
+
+
+def test_a_testbed_from_a_checked_plan_is_the_one_from_wheel_and_spec(mini_bed):
+    """A plan (plan_rig) carries the fit checks' result, so the testbed made from it checks nothing again and starts
+    where the one made from wheel and spec starts; a plan made for another bed, or with a wheel beside it, is refused."""
+    plan = plan_rig(mini_bed.spec, MINI_WHEEL, MINI_RUN)
+    assert plan.start_x == check_fits(mini_bed.spec, MINI_WHEEL, MINI_RUN)
+    direct, planned = Testbed(mini_bed, MINI_WHEEL, MINI_RUN), Testbed(mini_bed, plan=plan)
+    assert (planned.wheel, planned.spec, planned.start_x) == (direct.wheel, direct.spec, direct.start_x)
+    assert np.array_equal(planned.mesh.nodes, direct.mesh.nodes)
+    with pytest.raises(WheelsoilInputError, match="not the one the plan was made for"):
+        Testbed(mini_bed, plan=plan_rig(replace(MINI_BED, seed=MINI_BED.seed + 1), MINI_WHEEL, MINI_RUN))
+    with pytest.raises(WheelsoilInputError, match="either a plan or a wheel and spec"):
+        Testbed(mini_bed, MINI_WHEEL, plan=plan)
 
 
 def _mean_and_error(result, name, blocks=4):
