@@ -41,6 +41,12 @@ CANDIDATES = {
          "soil.density": cmu_sand.PLATE_FIT_MATERIAL.density},
         "The soil calibrated on the sand's plates alone (wheelsoil.parameters.cmu_sand.PLATE_FIT_PAIR): the shear\n"
         "box's peak 39 deg and 0.9 kPa against the chosen soil's 45 deg and 2.9 kPa."),
+    "rolling-fit": (
+        {"soil.static_friction": cmu_sand.MID_FIT_PAIR.static_friction,
+         "soil.rolling_friction": cmu_sand.MID_FIT_PAIR.rolling_friction,
+         "soil.density": cmu_sand.MID_FIT_MATERIAL.density},
+        "Between the two lab soils (wheelsoil.parameters.cmu_sand.MID_FIT_PAIR): sliding 0.51 and rolling 0.22, the\n"
+        "fraction 0.69 of the way from the chosen soil to the plate-only one fitted on the seen 0-deg driving trial."),
     "particle-scale": (
         {"soil.diameter_min": round(0.8 * cmu_sand.TWIN_DIAMETERS[0], 9),
          "soil.diameter_max": round(0.8 * cmu_sand.TWIN_DIAMETERS[1], 9)},

@@ -58,3 +58,16 @@ PLATE_FIT_CALIBRATION = {
     "shear_peak_cohesion_Pa": 942.0, "plate_log_mse": 0.188, "objective": 13.9,
     "candidate": "docs/soillab/calibration-epsd/candidates/mu0.5_mur0.1_epsd.json",
 }
+
+# ---------------------------------------------------------------- the twin's third DEM-side candidate (issue 34)
+#: Between the two lab soils, fitted on the seen trial (the grousered wheel at 0 deg, driving 0.5, trial 2.36 N):
+#: the fraction f of the way from the chosen soil (sliding 0.52, rolling 0.5; twin 9.17 N, steady) to the plate-only
+#: soil (0.5, 0.1; twin -0.73 N, window mean of a run that was not steady) at which the line through the two drawbar
+#: pulls meets the trial, f = (9.17 - 2.36) / (9.17 + 0.73) = 0.688, applied to both frictions (rounded to 0.01).
+#: Fixed on 2026-11-27 before any twin run at 45 or 90 deg had finished (docs/cmu-twin/README.md, "Candidates").
+MID_FIT_PAIR = PairProperties(restitution=0.5, static_friction=0.51, rolling_friction=0.22, rolling_model="epsd")
+#: Its particle density: the one whose poured bed has the sand's bulk density, from one poured bed at 2400 kg/m^3
+#: (``wheelsoil soil-lab poured --friction 0.51 --rolling-friction 0.22 --rolling-model epsd --density 2400 --seeds 0``:
+#: packing fraction 0.550, 1319 kg/m^3), so 1330 / 0.550 = 2420 kg/m^3.
+MID_FIT_MATERIAL = Material("cmu sand (between the lab soils)", youngs_modulus=50e6, poisson_ratio=0.3, density=2420.0)
+
