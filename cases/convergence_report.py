@@ -31,11 +31,11 @@ def _level_values(lv: Level) -> dict | None:
     if lv.folder is None or not (lv.folder / RESULT_NAME).is_file():
         return None
     r = load_result(lv.folder / RESULT_NAME)
-    out = {"steady": bool(r.summary["steady"]), "wall_seconds": float(r.info.get("wall_seconds", math.nan)),
+    out = {"steady": r.summary.steady, "wall_seconds": float(r.info.get("wall_seconds", math.nan)),
            "particles": int(r.info.get("particles", 0)), "dem_time_step": float(r.info.get("dem_time_step", math.nan))}
     for q in QUANTITIES:
-        st = r.summary.get(q, {})
-        out[q] = (float(st.get("mean", math.nan)), float(st.get("sem", math.nan)))
+        st = r.summary.quantity(q)
+        out[q] = (float(st.mean), float(st.sem))
     return out
 
 

@@ -44,7 +44,7 @@ def plot_series(result, path: str | Path, title: str) -> Path:
         twin.set_ylabel("wind-up [deg]", color="C1")
         axes[3].legend(fontsize=8, loc="upper left")
     axes[3].set_xlabel("time [s]")
-    t0, t1 = result.summary["window"]
+    t0, t1 = result.summary.window
     for ax in axes:
         ax.axvspan(t0, t1, color="0.9", zorder=0)
     axes[0].legend(fontsize=8, ncol=2)

@@ -167,8 +167,8 @@ def render_testbed(result, path: str | Path, **kwargs) -> Path:
     nodes = result.final_wheel_nodes
     hi[2] = max(hi[2], float(nodes[:, 2].max()))
     spec = result.spec
-    tread = result.summary.get("tread_slip", {}).get("mean", float("nan"))
-    verdict = "steady" if result.summary.get("steady") else "NOT steady"
+    tread = result.summary.tread_slip.mean
+    verdict = "steady" if result.summary.steady else "NOT steady"
     kwargs.setdefault("title", f"end of the run, t = {result.info['simulated_seconds']:.2f} s ({verdict}): slip "
                                f"{spec.slip:.2f} commanded, {tread:.3f} at the tread (window mean); steering "
                                f"{spec.slip_angle:g} deg")

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
+from wheelsoil.coupling.run_summary import RunSummary
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output
 
@@ -60,7 +61,7 @@ def make_replicas(base: CaseFile, seeds, out: str | Path) -> Sweep:
     return Sweep(name=f"replicas-{base.name}", cases=cases, out=out, swept_keys=["case.seed"])
 
 
-def _summaries(sweep: Sweep) -> list[tuple[int, dict | None]]:
+def _summaries(sweep: Sweep) -> list[tuple[int, RunSummary | None]]:
     from .results import load_result
 
     out = []
@@ -70,17 +71,17 @@ def _summaries(sweep: Sweep) -> list[tuple[int, dict | None]]:
     return out
 
 
-def replica_statistics(summaries: list[tuple[int, dict | None]]) -> dict:
+def replica_statistics(summaries: list[tuple[int, RunSummary | None]]) -> dict:
     """The replicas' statistics (see the module docstring) from (seed, summary or None) pairs."""
     done = [(s, m) for s, m in summaries if m is not None]
-    steady = [(s, m) for s, m in done if m["steady"]]
+    steady = [(s, m) for s, m in done if m.steady]
     result = {"seeds": [s for s, _ in summaries], "finished": [s for s, _ in done],
               "steady": [s for s, _ in steady], "quantities": {}}
     n = len(steady)
     for q in QUANTITIES:
-        x = np.array([m[q]["mean"] for _, m in steady], float)
-        sem = np.array([m[q]["sem"] for _, m in steady], float)
-        ci = np.array([m[q].get("ci95", math.nan) for _, m in steady], float)
+        x = np.array([m.quantity(q).mean for _, m in steady], float)
+        sem = np.array([m.quantity(q).sem for _, m in steady], float)
+        ci = np.array([m.quantity(q).ci95 for _, m in steady], float)
         row = {"n": n, "values": x.tolist(), "sems": sem.tolist()}
         if n >= 2:
             sd = float(np.std(x, ddof=1))

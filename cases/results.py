@@ -38,6 +38,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from wheelsoil.coupling.run_summary import RunSummary
 from wheelsoil.errors import WheelsoilInputError
 
 FRAME_FORMAT = "{:06d}"
@@ -121,7 +122,7 @@ class ResultWriter:
     def flush(self) -> None:
         self.file.flush()
 
-    def finish(self, series: dict, units: dict, summary: dict, info: dict) -> Path:
+    def finish(self, series: dict, units: dict, summary: RunSummary, info: dict) -> Path:
         """Write the series, summary and run info, mark complete, close and rename; returns the path."""
         f = self.file
         s = f.create_group("series")
@@ -129,15 +130,15 @@ class ResultWriter:
             s.create_dataset(name, data=np.asarray(values, np.float64))
             s[name].attrs["units"] = units[name]
         g = f.create_group("summary")
-        g.attrs["window_start"], g.attrs["window_end"] = summary["window"]
-        g.attrs["steady"] = bool(summary["steady"])
-        g.attrs["samples"] = int(summary["samples"])
-        for q, stats in summary.items():
-            if isinstance(stats, dict):
-                for key, value in stats.items():
-                    g.attrs[f"{q}_{key}"] = value
+        g.attrs["window_start"], g.attrs["window_end"] = summary.window
+        g.attrs["steady"] = bool(summary.steady)
+        g.attrs["samples"] = int(summary.samples)
+        for q, value in summary.to_dict().items():
+            if isinstance(value, dict):
+                for key, v in value.items():
+                    g.attrs[f"{q}_{key}"] = v
             elif q not in ("window", "steady", "samples"):
-                g.attrs[q] = json.dumps(stats) if isinstance(stats, (list, tuple)) else stats
+                g.attrs[q] = json.dumps(value) if isinstance(value, (list, tuple)) else value
         r = f.create_group("run")
         for key, value in info.items():
             r.attrs[key] = value
@@ -158,15 +159,16 @@ class ResultWriter:
 class Result:
     """A finished run read back: time series and summary as NumPy (and pandas) objects.
 
-    ``series``: name -> 1-D array; ``units``: name -> unit; ``summary``: steady-state means and
-    standard deviations (``summary['drawbar_pull']['mean']``), the window and whether it was steady;
+    ``series``: name -> 1-D array; ``units``: name -> unit; ``summary``: the steady-state summary
+    (:class:`~wheelsoil.coupling.run_summary.RunSummary`: ``summary.drawbar_pull.mean``, the window, whether it was
+    steady);
     ``attrs``: provenance and the resolved case text (``attrs['case_toml']``); ``info``: run figures.
     """
 
     path: Path
     series: dict
     units: dict
-    summary: dict
+    summary: RunSummary
     attrs: dict
     info: dict
     frame_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -187,7 +189,7 @@ class Result:
 
     def steady(self, name: str) -> float:
         """Steady-state mean of a quantity."""
-        return float(self.summary[name]["mean"])
+        return self.summary.mean(name)
 
     def to_dataframe(self):
         """The time series as a pandas DataFrame indexed by t [s] (columns named ``name [unit]``)."""
@@ -199,14 +201,12 @@ class Result:
 
     def summary_row(self) -> dict:
         """One flat row: case name and hash, the steady means and standard deviations, the window."""
-        row = {"case": self.attrs.get("case_name"), "case_hash": self.attrs.get("case_hash")}
-        for key in ("steady", "samples"):
-            row[key] = self.summary[key]
-        row["window_start"], row["window_end"] = self.summary["window"]
-        for q, stats in self.summary.items():
-            if isinstance(stats, dict):
-                row[f"{q}_mean"] = stats["mean"]
-                row[f"{q}_std"] = stats["std"]
+        row = {"case": self.attrs.get("case_name"), "case_hash": self.attrs.get("case_hash"),
+               "steady": self.summary.steady, "samples": self.summary.samples}
+        row["window_start"], row["window_end"] = self.summary.window
+        for q, stats in self.summary.quantities().items():
+            row[f"{q}_mean"] = stats.mean
+            row[f"{q}_std"] = stats.std
         return row
 
     def frame(self, k: int) -> dict:
@@ -253,12 +253,13 @@ def load_result(path: str | Path) -> Result:
         series = {k: f["series"][k][()] for k in f["series"]}
         units = {k: attr_value(f["series"][k].attrs["units"]) for k in f["series"]}
         sa = {k: attr_value(v) for k, v in f["summary"].attrs.items()}
-        summary = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
-                   "samples": int(sa.pop("samples"))}
+        stored = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
+                  "samples": int(sa.pop("samples"))}
         for key in [k[:-5] for k in sa if k.endswith("_mean")]:
-            summary[key] = {stat: sa.pop(f"{key}_{stat}") for stat in SUMMARY_STATS if f"{key}_{stat}" in sa}
+            stored[key] = {stat: sa.pop(f"{key}_{stat}") for stat in SUMMARY_STATS if f"{key}_{stat}" in sa}
         for key, value in sa.items():
-            summary[key] = json.loads(value) if key == "reasons" else value
+            stored[key] = json.loads(value) if key == "reasons" else value
+        summary = RunSummary.from_dict(stored)
         attrs = {k: attr_value(v) for k, v in f.attrs.items()}
         info = {k: attr_value(v) for k, v in f["run"].attrs.items()}
         times = np.array([f["frames"][k].attrs["t"] for k in sorted(f["frames"])])

@@ -96,7 +96,8 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     :class:`~wheelsoil.errors.SimulationUnstableError` when the run blows up; a run that fails after
     a checkpoint keeps its partial files, so that ``resume=True`` can continue it.
     """
-    from wheelsoil.coupling.testbed import SERIES_UNITS, Testbed
+    from wheelsoil.coupling.run_summary import SERIES_UNITS
+    from wheelsoil.coupling.testbed import Testbed
     from wheelsoil.granular import prepare_bed
 
     say = console.print if console is not None else (lambda *a, **k: None)
@@ -186,7 +187,7 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
 
 def write_run_folder(out: Path, case: CaseFile, result, prov: dict) -> list[Path]:
     """series.csv, summary.json, case.toml, series.png and (if the case asks) final.png."""
-    from wheelsoil.coupling.testbed import SERIES_UNITS
+    from wheelsoil.coupling.run_summary import SERIES_UNITS
 
     names = list(SERIES_UNITS)
     rows = [",".join(f"{n}[{SERIES_UNITS[n]}]" for n in names)]
@@ -195,7 +196,7 @@ def write_run_folder(out: Path, case: CaseFile, result, prov: dict) -> list[Path
     with atomic_output(out / "series.csv") as tmp:
         tmp.write_text("\n".join(rows) + "\n")
     written.append(out / "series.csv")
-    summary = {"case": case.name, "case_hash": case.case_hash(), "summary": result.summary, "run": result.info,
+    summary = {"case": case.name, "case_hash": case.case_hash(), "summary": result.summary.to_dict(), "run": result.info,
                "testbed": result.spec.to_dict(), "bed": result.bed_summary, "provenance": prov}
     with atomic_output(out / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2, default=str))

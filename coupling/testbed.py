@@ -69,36 +69,9 @@ from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg
 from .patch import MovingPatch
 from .rig import RigPlan, TestbedSpec, batches_per_period, carriage_speed, plan_rig, soil_headroom, statistics_pitch
+from .run_summary import SERIES_UNITS, STEADY_CHECKED, STEADY_QUANTITIES, QuantityStats, RunSummary
 from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
 
-#: Series recorded at every sample, with units.
-SERIES_UNITS = {
-    "t": "s",
-    "drawbar_pull": "N",
-    "lateral_force": "N",
-    "vertical_force": "N",
-    "torque": "N m",
-    "sinkage": "m",
-    "tread_sinkage": "m",
-    "slip": "1",
-    "slip_angle": "deg",
-    "tread_slip": "1",
-    "tread_slip_angle": "deg",
-    "wind_up": "rad",
-    "tread_omega": "rad/s",
-    "slip_speed": "m/s",
-    "load": "N",
-    "omega": "rad/s",
-    "travel": "m",
-    "hub_x": "m",
-    "hub_y": "m",
-    "hub_z": "m",
-    "contacts": "1",
-}
-#: Quantities whose drift the steady-state detector checks (the tread slip is checked on its own).
-STEADY_CHECKED = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage")
-#: Quantities averaged over the steady window.
-STEADY_QUANTITIES = STEADY_CHECKED + ("tread_sinkage", "slip", "slip_angle", "tread_slip_angle", "wind_up")
 PHASES = ("new", "lower", "settle", "spin-up", "wind-up", "drive", "done")
 
 
@@ -114,7 +87,7 @@ class TestbedResult:
     __test__ = False
 
     series: dict
-    summary: dict
+    summary: RunSummary
     spec: TestbedSpec
     wheel: WheelGeometry
     bed_summary: str
@@ -125,8 +98,8 @@ class TestbedResult:
     mesh: StructureMesh | None = None
 
     def steady(self, name: str) -> float:
-        """Steady-state mean of a quantity (see :data:`STEADY_QUANTITIES`, and ``tread_slip``)."""
-        return float(self.summary[name]["mean"])
+        """Steady-state mean of a quantity (see :data:`~.run_summary.SUMMARY_QUANTITIES`)."""
+        return self.summary.mean(name)
 
 
 class Testbed:
@@ -497,12 +470,7 @@ class Testbed:
         if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
             k1 = len(t)
             k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
-        summary = {
-            "steady": bool(state.steady), "window": [float(t[k0] - self.steps_per_sample * self.dt), float(t[k1 - 1])],
-            "samples": int(k1 - k0), "pitches": int(state.pitches), "pitch_deg": math.degrees(self.pitch),
-            "period_pitches": self.period_pitches,
-            "reasons": list(state.reasons), "commanded_slip": s.slip, "commanded_slip_angle": s.slip_angle,
-        }
+        quantities = {}
         for q in STEADY_QUANTITIES:
             y = rows[q][k0:k1]
             st = state.stats.get(q)
@@ -510,19 +478,23 @@ class Testbed:
                 # batch means over the same pitches
                 st = window_stats(np.asarray(rows[q], float), state.bounds, period=self.period_pitches)
             st = st or {}
-            summary[q] = {"mean": float(np.mean(y)), "std": float(np.std(y)), "sem": float(st.get("sem", math.nan)),
-                          "ci95": float(st.get("ci95", math.nan)), "dof": float(st.get("dof", math.nan)),
-                          "drift": float(st.get("drift", math.nan)), "drift_sem": float(st.get("drift_sem", math.nan)),
-                          "units": SERIES_UNITS[q]}
-            if "zero_within_noise" in st:
-                summary[q]["zero_within_noise"] = bool(st["zero_within_noise"])
+            quantities[q] = QuantityStats(
+                mean=float(np.mean(y)), std=float(np.std(y)), sem=float(st.get("sem", math.nan)),
+                ci95=float(st.get("ci95", math.nan)), dof=float(st.get("dof", math.nan)),
+                drift=float(st.get("drift", math.nan)), drift_sem=float(st.get("drift_sem", math.nan)),
+                units=SERIES_UNITS[q],
+                zero_within_noise=bool(st["zero_within_noise"]) if "zero_within_noise" in st else None)
         ts = state.stats.get("tread_slip")
         if ts is not None:
-            summary["tread_slip"] = {**{k: float(v) for k, v in ts.items()}, "units": "1"}
+            quantities["tread_slip"] = QuantityStats(**{k: float(v) for k, v in ts.items()}, units="1")
         else:
-            summary["tread_slip"] = {"mean": float(np.mean(rows["tread_slip"][k0:k1])),
-                                     "std": float(np.std(rows["tread_slip"][k0:k1])), "sem": math.nan, "ci95": math.nan, "dof": math.nan,
-                                     "drift": math.nan, "units": "1"}
+            y = rows["tread_slip"][k0:k1]
+            quantities["tread_slip"] = QuantityStats(float(np.mean(y)), float(np.std(y)), units="1")
+        summary = RunSummary(
+            steady=bool(state.steady), window=(float(t[k0] - self.steps_per_sample * self.dt), float(t[k1 - 1])),
+            samples=int(k1 - k0), pitches=int(state.pitches), pitch_deg=math.degrees(self.pitch),
+            period_pitches=self.period_pitches, reasons=tuple(state.reasons), commanded_slip=s.slip,
+            commanded_slip_angle=s.slip_angle, **quantities)
         particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
         nodes = self.structure.positions()
         info = {

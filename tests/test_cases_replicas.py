@@ -9,6 +9,7 @@ import pytest
 
 from wheelsoil.cases.replicas import QUANTITIES, check_seeds, make_replicas, replica_statistics, report_markdown
 from wheelsoil.cases.schema import load_case
+from wheelsoil.coupling.run_summary import QuantityStats, RunSummary
 from wheelsoil.errors import WheelsoilInputError
 
 
@@ -17,10 +18,11 @@ def _campaign(rng, n, sigma, stated, steady=True):
     ci95 the normal 1.96 x sem."""
     out = []
     for seed in range(n):
-        summary = {"steady": steady}
-        for q in QUANTITIES:
-            summary[q] = {"mean": 100.0 + rng.normal(0.0, sigma), "sem": stated, "ci95": 1.96 * stated}
-        out.append((seed, summary))
+        quantities = {q: QuantityStats(100.0 + rng.normal(0.0, sigma), math.nan, sem=stated, ci95=1.96 * stated)
+                      for q in QUANTITIES}
+        out.append((seed, RunSummary(steady=steady, window=(0.0, 1.0), samples=10, pitches=4, pitch_deg=45.0,
+                                     period_pitches=1, reasons=(), commanded_slip=0.3, commanded_slip_angle=0.0,
+                                     **quantities)))
     return out
 
 
@@ -46,7 +48,7 @@ def test_inflation_and_coverage_on_synthetic_campaigns(seed, stated, inflation, 
 
 def test_runs_not_steady_or_not_finished_are_left_out_and_said(tmp_path):
     rng = np.random.default_rng(0)
-    summaries = _campaign(rng, 3, 1.0, 1.0) + [(7, {**_campaign(rng, 1, 1.0, 1.0)[0][1], "steady": False}), (8, None)]
+    summaries = _campaign(rng, 3, 1.0, 1.0) + [(7, _campaign(rng, 1, 1.0, 1.0, steady=False)[0][1]), (8, None)]
     stats = replica_statistics(summaries)
     assert stats["steady"] == [0, 1, 2] and stats["finished"] == [0, 1, 2, 7]
     assert stats["quantities"]["torque"]["n"] == 3

@@ -14,7 +14,7 @@ from wheelsoil.cases.cli import EXIT_INPUT, main
 from wheelsoil.cases.results import load_result, partial_path
 from wheelsoil.cases.run import CHECKPOINT_NAME, RESULT_NAME, run_case
 from wheelsoil.cases.schema import load_case
-from wheelsoil.coupling.testbed import SERIES_UNITS, STEADY_QUANTITIES
+from wheelsoil.coupling.run_summary import SERIES_UNITS, STEADY_QUANTITIES
 from wheelsoil.errors import WheelsoilInputError
 
 #: The mini case, short: about 0.32 s simulated (lowering, settling, 0.15 s of driving), frames every
@@ -78,7 +78,7 @@ def test_round_trip_case_to_result_to_case(reference, tmp_path):
     assert load_case(out / "case.toml") == case  # the run folder's case.toml runs the same case
     for name in SERIES_UNITS:
         np.testing.assert_array_equal(result.series[name], outcome.testbed_result.series[name])
-    assert result.steady("drawbar_pull") == outcome.testbed_result.summary["drawbar_pull"]["mean"]
+    assert result.steady("drawbar_pull") == outcome.testbed_result.summary.drawbar_pull.mean
     frame = result.to_dataframe()
     assert "drawbar_pull [N]" in frame.columns and frame.index.name == "t [s]"
     assert len(frame) == len(result.series["t"])

@@ -40,18 +40,18 @@ def test_steady_state_force_balance_and_signs(steering_run):
     s = result.summary
     w = MINI_RUN.load
     # the axle is free vertically under W: in steady state the soil carries W
-    assert s["vertical_force"]["mean"] == pytest.approx(w, rel=0.15)
+    assert s.vertical_force.mean == pytest.approx(w, rel=0.15)
     # the rig commands slip and slip angle exactly (the hub's); the tread's are measured and recorded beside them
-    assert s["slip"]["mean"] == pytest.approx(0.3, abs=1e-9)
-    assert s["slip_angle"]["mean"] == pytest.approx(10.0, abs=1e-9)
-    assert s["commanded_slip"] == 0.3 and np.isfinite(s["tread_slip"]["mean"])
+    assert s.slip.mean == pytest.approx(0.3, abs=1e-9)
+    assert s.slip_angle.mean == pytest.approx(10.0, abs=1e-9)
+    assert s.commanded_slip == 0.3 and np.isfinite(s.tread_slip.mean)
     # a 0.3 s drive of a winding-up wheel is not a steady state, and the summary says why
-    assert not s["steady"] and s["reasons"]
+    assert not s.steady and s.reasons
     # a driven wheel at 30 % slip pulls and needs torque; the soil resists the lateral slip (v_y > 0)
-    assert s["drawbar_pull"]["mean"] > 0.0
-    assert s["torque"]["mean"] > 0.0
-    assert s["lateral_force"]["mean"] < 0.0
-    assert 0.0 < s["sinkage"]["mean"] < 0.5 * MINI_WHEEL.radius
+    assert s.drawbar_pull.mean > 0.0
+    assert s.torque.mean > 0.0
+    assert s.lateral_force.mean < 0.0
+    assert 0.0 < s.sinkage.mean < 0.5 * MINI_WHEEL.radius
     # series are complete and finite
     n = len(result.series["t"])
     assert all(len(v) == n and np.all(np.isfinite(v)) for v in result.series.values())
@@ -123,11 +123,11 @@ def test_braking_dragged_and_sideways_wheels_follow_the_rigs_convention(mini_bed
     assert np.allclose(result.series["slip_angle"][drive], beta, atol=1e-6)
     s = result.summary
     if slip < 0.0:
-        assert s["drawbar_pull"]["mean"] < 0.0
+        assert s.drawbar_pull.mean < 0.0
     if slip == -1.0:
-        assert s["torque"]["mean"] < 0.0
+        assert s.torque.mean < 0.0
     if beta == 90.0:
-        assert s["lateral_force"]["mean"] < 0.0
+        assert s.lateral_force.mean < 0.0
 
 
 @pytest.mark.parametrize(
@@ -204,7 +204,7 @@ def test_a_testbed_from_a_checked_plan_is_the_one_from_wheel_and_spec(mini_bed):
 
 def _mean_and_error(result, name, blocks=4):
     """Steady mean and its standard error from block means (the series is correlated in time)."""
-    t0 = result.summary["window"][0]
+    t0 = result.summary.window[0]
     y = result.series[name][result.series["t"] >= t0]
     means = np.array([b.mean() for b in np.array_split(y, blocks)])
     return means.mean(), means.std(ddof=1) / np.sqrt(blocks)

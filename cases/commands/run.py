@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from . import common
+
+if TYPE_CHECKING:
+    from wheelsoil.coupling.run_summary import RunSummary
 
 
 def add_parser(sub) -> None:
@@ -57,29 +61,27 @@ def case_from_args(args):
     return load_case(args.case, overrides)
 
 
-def summary_lines(s: dict) -> list[str]:
+def summary_lines(s: RunSummary) -> list[str]:
     """The steady-state summary of a run as terminal lines (rich markup): the verdict, the window, the means
     with their standard errors, and the tread's slip beside the commanded one."""
-    span = f"t = {s['window'][0]:.2f}-{s['window'][1]:.2f} s"
-    if s["steady"]:
-        period = s.get("period_pitches", 1)
-        periods = f", {s.get('pitches', 0) // period} wheel periods of {period * s.get('pitch_deg', 0):.0f} deg" if period > 1 else ""
-        head = f"[green]steady[/] over {span} ({s.get('pitches', 0)} pitches of {s.get('pitch_deg', 0):.1f} deg{periods}):"
+    span = f"t = {s.window[0]:.2f}-{s.window[1]:.2f} s"
+    if s.steady:
+        period = s.period_pitches
+        periods = f", {s.pitches // period} wheel periods of {period * s.pitch_deg:.0f} deg" if period > 1 else ""
+        head = f"[green]steady[/] over {span} ({s.pitches} pitches of {s.pitch_deg:.1f} deg{periods}):"
     else:
         head = f"[yellow]NOT steady[/]: averaged the last window, {span}, for information only:"
     lines = [head]
     for q in ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage", "tread_sinkage"):
-        st = s[q]
-        sem, ci = st.get("sem", float("nan")), st.get("ci95", float("nan"))
-        zero = ": zero within its noise, no trend" if st.get("zero_within_noise") else ""
-        interval = f", 95 % interval +-{ci:.2g}" if math.isfinite(ci) else ""
-        lines.append(f"  {q:16s} {st['mean']:10.4g} {st['units']:4s} (standard error {sem:.2g}{interval}, fluctuation "
-                     f"{st['std']:.3g}{zero})")
-    if "tread_slip" in s:
-        lines.append(f"  {'tread slip':16s} {s['tread_slip']['mean']:10.4f}      (commanded {s.get('commanded_slip', float('nan')):g}; "
-                     f"tread slip angle {s['tread_slip_angle']['mean']:.2f} deg, commanded "
-                     f"{s.get('commanded_slip_angle', float('nan')):g}; wind-up {s['wind_up']['mean']:.3f} rad)")
-    for reason in s.get("reasons", []):
+        st = s.quantity(q)
+        zero = ": zero within its noise, no trend" if st.zero_within_noise else ""
+        interval = f", 95 % interval +-{st.ci95:.2g}" if math.isfinite(st.ci95) else ""
+        lines.append(f"  {q:16s} {st.mean:10.4g} {st.units:4s} (standard error {st.sem:.2g}{interval}, fluctuation "
+                     f"{st.std:.3g}{zero})")
+    lines.append(f"  {'tread slip':16s} {s.tread_slip.mean:10.4f}      (commanded {s.commanded_slip:g}; "
+                 f"tread slip angle {s.tread_slip_angle.mean:.2f} deg, commanded "
+                 f"{s.commanded_slip_angle:g}; wind-up {s.wind_up.mean:.3f} rad)")
+    for reason in s.reasons:
         lines.append(f"  [yellow]not steady:[/] {reason}")
     return lines
 
