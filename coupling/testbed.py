@@ -68,11 +68,10 @@ from wheelsoil.granular.bed import Bed
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg
 from .patch import MovingPatch
+from .protocol_state import ProtocolState
 from .rig import RigPlan, TestbedSpec, batches_per_period, carriage_speed, plan_rig, soil_headroom, statistics_pitch
 from .run_summary import SERIES_UNITS, STEADY_CHECKED, STEADY_QUANTITIES, QuantityStats, RunSummary
 from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
-
-PHASES = ("new", "lower", "settle", "spin-up", "wind-up", "drive", "done")
 
 
 def yaw_matrix(angle_rad: float) -> np.ndarray:
@@ -205,7 +204,7 @@ class Testbed:
         self.steps_per_sample = max(1, int(round(spec.sample_interval / self.dt)))
         self.structure.drive_hub(velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                                  free_translation=(False, False, False), free_rotation=(False, False, False))
-        self._loop: dict | None = None
+        self._loop: ProtocolState | None = None
         self.rows: dict | None = None
         self.steady_state: SteadyState | None = None
 
@@ -240,70 +239,68 @@ class Testbed:
         """
         if self._loop is None:
             self._start()
-        if self._loop["phase"] == "done":
+        if self._loop.phase == "done":
             raise WheelsoilInputError("this testbed has finished its run; build a new Testbed to run again")
-        wall = time.perf_counter() - self._loop["wall"]
+        wall = time.perf_counter() - self._loop.wall
         bar = _ProgressBar(self) if progress else None
         try:
             while not self._sample():
                 if bar is not None:
                     bar.update()
                 if on_sample is not None:
-                    self._loop["wall"] = time.perf_counter() - wall
+                    self._loop.wall = time.perf_counter() - wall
                     on_sample(self)
         finally:
             if bar is not None:
                 bar.stop()
         self.scene.check_health()
         self.structure.check_health()
-        self._loop["phase"] = "done"
+        self._loop.phase = "done"
         return self._result({k: np.asarray(v) for k, v in self.rows.items()}, time.perf_counter() - wall)
 
     def _start(self) -> None:
         s = self.spec
-        self._loop = {"phase": "lower", "t_release": math.inf, "t_spin": math.inf, "t_windup": math.inf,
-                      "t_hold": math.inf, "wall": 0.0, "hub_angle": 0.0, "omega_filtered": 0.0,
-                      "hub_spin": 0.0, "shift": 0.0, "next_check": math.inf, "windup_converged": False}
+        self._loop = ProtocolState()
         self.rows = {k: [] for k in SERIES_UNITS}
         self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
         self.contact.mean_resultant(reset=True)
 
     @property
     def phase(self) -> str:
-        """Where the protocol is: one of :data:`PHASES`."""
-        return self._loop["phase"] if self._loop else "new"
+        """Where the protocol is: one of :data:`~.protocol_state.PHASES`."""
+        return self._loop.phase if self._loop else "new"
 
     def _set_drive(self) -> None:
         """The hub's spin and the carriage's speed for the sample about to be taken."""
         s, loop = self.spec, self._loop
         t = self.scene.time
-        phase = loop["phase"]
+        phase = loop.phase
         omega = self.spin_command
         if phase == "spin-up":
-            ramp = min(1.0, (t - loop["t_spin"]) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
+            ramp = min(1.0, (t - loop.t_spin) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
             spin, carriage = omega * ramp, self.travel_speed * ramp
         elif phase == "wind-up":
-            spin = omega + s.windup_gain * (omega - loop["omega_filtered"])
+            spin = omega + s.windup_gain * (omega - loop.omega_filtered)
             spin, carriage = min(max(spin, 0.5 * omega), 1.5 * omega), self.travel_speed
         elif phase == "drive":
             spin, carriage = omega, self.travel_speed
         else:
             return
-        loop["hub_spin"] = spin
+        loop.hub_spin = spin
         self._command(spin, carriage)
 
     def _sample(self) -> bool:
         """Advance one sample interval, record it and move the protocol on; True when the run is over."""
         s, loop, rows = self.spec, self._loop, self.rows
         self._set_drive()
-        phase = loop["phase"]
+        phase = loop.phase
         if phase != "lower" and self.axle_damping > 0.0:
             self._apply_load(float(self.structure.hub_velocity[2]))
         self.scene.step(self.steps_per_sample)
         if self.patch is not None:
             self.patch.drop_thrown_out(self.scene)
         interval = self.steps_per_sample * self.dt
-        loop["hub_angle"] += loop["hub_spin"] * interval
+        loop.hub_angle += loop.hub_spin * interval
         row = self._measure(phase, interval)
         for key, val in row.items():
             rows[key].append(float(val))
@@ -314,7 +311,7 @@ class Testbed:
                 f"the hub under {row['torque']:.0f} N m of torque (spokes buckling through?); a stiffer wheel, a "
                 "lower load or slip, or a larger test.max_wind_up if the twist is real")
         if self.patch is not None and phase != "lower":
-            loop["shift"] += self.patch.update(self)
+            loop.shift += self.patch.update(self)
         return self._advance_phase(row)
 
     def _measure(self, phase: str, interval: float) -> dict:
@@ -325,11 +322,11 @@ class Testbed:
         spin = float(self.structure.hub_angular_velocity @ self.axle)
         nodes = self.structure.positions()
         tread = self.tracker.state(nodes[self._tread_nodes], self.structure.hub_rotation)
-        tread_angle = loop["hub_angle"] - tread.wind_up
-        previous = loop.get("tread_angle", tread_angle)
-        loop["tread_angle"] = tread_angle
+        tread_angle = loop.hub_angle - tread.wind_up
+        previous = tread_angle if loop.tread_angle is None else loop.tread_angle
+        loop.tread_angle = tread_angle
         tread_omega = (tread_angle - previous) / interval
-        loop["omega_filtered"] += (tread_omega - loop["omega_filtered"]) * min(1.0, interval / s.windup_filter)
+        loop.omega_filtered += (tread_omega - loop.omega_filtered) * min(1.0, interval / s.windup_filter)
         vx = float(vel @ self.heading)
         vx_tread = float(vel @ tread.heading)
         if self.spec.slip_speed == "travel":  # the whole horizontal travel speed, the same for hub and tread
@@ -352,7 +349,7 @@ class Testbed:
             "slip_speed": vx_tread,
             "load": s.load if phase != "lower" else 0.0,
             "omega": spin,
-            "travel": hub[0] + loop["shift"] - self.start_x,
+            "travel": hub[0] + loop.shift - self.start_x,
             "hub_x": hub[0], "hub_y": hub[1], "hub_z": hub[2],
             "contacts": self.contact.contact_count,
         }
@@ -360,37 +357,37 @@ class Testbed:
     def _advance_phase(self, row: dict) -> bool:
         s, loop = self.spec, self._loop
         t = self.scene.time
-        phase = loop["phase"]
+        phase = loop.phase
         if phase == "lower":
             if row["vertical_force"] >= s.load:
                 self._release()
-                loop["phase"], loop["t_release"] = "settle", t
+                loop.phase, loop.t_release = "settle", t
             elif row["sinkage"] > 0.5 * self.wheel.radius:
                 raise SimulationUnstableError(
                     f"the bed does not carry the load {s.load} N: the wheel sank {row['sinkage']:.3f} m "
                     f"(more than half its radius) while lowered, with the soil carrying {row['vertical_force']:.1f} N")
-        elif phase == "settle" and t >= loop["t_release"] + s.settle_time - 1e-12:
-            loop["phase"], loop["t_spin"] = "spin-up", t
-            loop["omega_filtered"] = 0.0
-        elif phase == "spin-up" and t >= loop["t_spin"] + s.spin_up_time - 1e-12:
-            loop["t_windup"] = t
+        elif phase == "settle" and t >= loop.t_release + s.settle_time - 1e-12:
+            loop.phase, loop.t_spin = "spin-up", t
+            loop.omega_filtered = 0.0
+        elif phase == "spin-up" and t >= loop.t_spin + s.spin_up_time - 1e-12:
+            loop.t_windup = t
             if s.windup == "controller" and not s.rigid:  # a rigid wheel has nothing to wind up
-                loop["phase"] = "wind-up"
+                loop.phase = "wind-up"
             else:
                 self._hold(t)
         elif phase == "wind-up":
-            if self._wound_up() or t >= loop["t_windup"] + 0.5 * s.drive_time:
-                loop["windup_converged"] = self._wound_up()
+            if self._wound_up() or t >= loop.t_windup + 0.5 * s.drive_time:
+                loop.windup_converged = self._wound_up()
                 self._hold(t)
-        elif phase == "drive" and t >= loop["next_check"] - 1e-12:
-            loop["next_check"] = t + self.pitch / self.batch_rate
-            ended = t >= loop["t_windup"] + s.drive_time - 1e-12
+        elif phase == "drive" and t >= loop.next_check - 1e-12:
+            loop.next_check = t + self.pitch / self.batch_rate
+            ended = t >= loop.t_windup + s.drive_time - 1e-12
             if s.stop_when_steady or ended:
                 state = self._detect()
                 if state.steady and not self._window_long_enough(state):
                     state = replace(state, steady=False, reasons=["the steady window is shorter than average_time"])
-                self.steady_state, loop["steady_in_a_row"] = confirm_steady(
-                    state, loop.get("steady_in_a_row", 0), s.steady_checks)
+                self.steady_state, loop.steady_in_a_row = confirm_steady(
+                    state, loop.steady_in_a_row, s.steady_checks)
                 done = self.steady_state.steady
                 if (done and s.stop_when_steady) or ended:
                     return True
@@ -399,11 +396,11 @@ class Testbed:
     def _hold(self, t: float) -> None:
         """End the wind-up: from now on the hub spins at exactly omega."""
         loop = self._loop
-        loop["phase"], loop["t_hold"] = "drive", t
+        loop.phase, loop.t_hold = "drive", t
         # the first window may start one whole period after the hold (the hub's step from the controller's
         # spin to omega is a small disturbance the wheel rides out within a period)
-        loop["t_average_from"] = t + self.pitch / self.batch_rate
-        loop["next_check"] = loop["t_average_from"] + self.spec.average_time
+        loop.t_average_from = t + self.pitch / self.batch_rate
+        loop.next_check = loop.t_average_from + self.spec.average_time
 
     def _wound_up(self) -> bool:
         """The tread's spin over its last pitch gives the commanded slip within a third of the tolerance, and
@@ -412,11 +409,11 @@ class Testbed:
         omega_t = np.asarray(rows["tread_omega"])
         t = np.asarray(rows["t"])
         n_pitch = int(math.ceil(self.pitch / self.batch_rate / (self.steps_per_sample * self.dt)))
-        if len(t) < n_pitch or t[-n_pitch] < self._loop["t_windup"]:
+        if len(t) < n_pitch or t[-n_pitch] < self._loop.t_windup:
             return False
         r, v = self.wheel.radius, self.slip_reference_speed
         slip_error = abs(longitudinal_slip(v, float(omega_t[-n_pitch:].mean()), r) - s.slip)
-        spin_error = abs(longitudinal_slip(v, self._loop["hub_spin"], r) - s.slip)
+        spin_error = abs(longitudinal_slip(v, self._loop.hub_spin, r) - s.slip)
         return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
 
     def _window_long_enough(self, state: SteadyState) -> bool:
@@ -428,7 +425,7 @@ class Testbed:
             self.rows, slip=s.slip, load=s.load, angular_velocity=s.angular_velocity, average_time=s.average_time,
             steady_tolerance=s.steady_tolerance, slip_tolerance=s.slip_tolerance, radius=self.wheel.radius,
             pitch=self.pitch, mean_diameter=0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max),
-            sample_interval=self.steps_per_sample * self.dt, start=self._loop.get("t_average_from", math.inf),
+            sample_interval=self.steps_per_sample * self.dt, start=self._loop.t_average_from,
             period_pitches=self.period_pitches)
 
     # ------------------------------------------------------------------ checkpoints
@@ -439,11 +436,11 @@ class Testbed:
         neighbour lists are rebuilt at the next step; the wheel contact rebuilds its candidates), so a
         run continued from a restored state steps exactly as the run that took the state does.
         """
-        if self._loop is None or self._loop["phase"] == "done":
+        if self._loop is None or self._loop.phase == "done":
             raise WheelsoilInputError("a testbed state can only be taken during a run (from on_sample)")
         state = {"scene": self.scene.state(), "structure": self.structure.state(), "contact": self.contact.state()}
         self.contact.invalidate()
-        state["testbed"] = {"loop": dict(self._loop), "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
+        state["testbed"] = {"loop": self._loop.to_dict(), "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
         if self.patch is not None:
             state["patch"] = self.patch.state()
         return state
@@ -458,7 +455,7 @@ class Testbed:
         self.contact.restore_state(self.scene, state["contact"])
         if self.patch is not None:
             self.patch.restore_state(state["patch"])
-        self._loop = dict(state["testbed"]["loop"])
+        self._loop = ProtocolState.from_dict(state["testbed"]["loop"])
         self.rows = {k: [float(v) for v in np.asarray(rows[k])] for k in SERIES_UNITS}
 
     # ------------------------------------------------------------------ the result
@@ -510,8 +507,8 @@ class Testbed:
             "wheel_mass": self.wheel_mass,
             "contact_rebuilds": self.contact.rebuilds,
             "seconds_per_simulated_second": wall / max(float(t[-1]), 1e-12),
-            "t_released": loop["t_release"], "t_spin_up": loop["t_spin"], "t_wind_up": loop["t_windup"],
-            "t_hold": loop["t_hold"], "wind_up_converged": bool(loop["windup_converged"]),
+            "t_released": loop.t_release, "t_spin_up": loop.t_spin, "t_wind_up": loop.t_windup,
+            "t_hold": loop.t_hold, "wind_up_converged": bool(loop.windup_converged),
             "patch_shifts": int(self.patch.shifts) if self.patch is not None else 0,
             # grains launched above the soil's domain at one health check, at most (Scene.check_health)
             "most_grains_above_top": int(self.scene.most_above_top),
@@ -546,13 +543,13 @@ class _ProgressBar:
         b, rows = self.bench, self.bench.rows
         loop, s = b._loop, b.spec
         total = completed = None
-        if math.isfinite(loop["t_spin"]):
-            end = loop["t_spin"] + s.spin_up_time + s.drive_time
-            total, completed = 1000, int(1000 * min(1.0, (b.scene.time - loop["t_release"]) / (end - loop["t_release"])))
+        if math.isfinite(loop.t_spin):
+            end = loop.t_spin + s.spin_up_time + s.drive_time
+            total, completed = 1000, int(1000 * min(1.0, (b.scene.time - loop.t_release) / (end - loop.t_release)))
         text = (f"{loop['phase']:8s} t = {b.scene.time:.3f} s  DP {rows['drawbar_pull'][-1]:8.1f} N  "
                 f"Fz {rows['vertical_force'][-1]:8.1f} N  T {rows['torque'][-1]:7.1f} N m  "
                 f"sinkage {1e3 * rows['sinkage'][-1]:6.1f} mm")
-        if loop["phase"] in ("wind-up", "drive"):
+        if loop.phase in ("wind-up", "drive"):
             n = max(1, int(b.pitch / b.batch_rate / (b.steps_per_sample * b.dt)))
             omega_t = float(np.mean(rows["tread_omega"][-n:]))
             slip = longitudinal_slip(b.slip_reference_speed, omega_t, b.wheel.radius)

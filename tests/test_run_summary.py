@@ -42,3 +42,28 @@ def test_a_result_written_before_a_field_existed_still_reads():
     s = RunSummary.from_dict(old)
     assert s.period_pitches == 1 and s.reasons == () and s.drawbar_pull.sem == 0.4
     assert math.isnan(s.drawbar_pull.drift_sem) and math.isnan(s.tread_slip_angle.mean)
+
+
+def test_the_protocol_state_round_trips_through_a_checkpoint_and_refuses_unknown_keys(tmp_path):
+    """The testbed's protocol state goes to a checkpoint file as plain scalars and comes back equal (inf times,
+    the phase's name, the counters); a checkpoint from an older version, without the later keys, reads with their
+    defaults; an unknown key or phase is refused."""
+    import numpy as np
+
+    from wheelsoil.cases.run import load_checkpoint, save_checkpoint
+    from wheelsoil.coupling.protocol_state import ProtocolState
+
+    state = ProtocolState(phase="drive", t_release=0.4, t_spin=0.5, t_windup=0.9, t_hold=1.2, t_average_from=1.5,
+                          next_check=2.0, hub_angle=3.1, hub_spin=1.7, omega_filtered=1.6, tread_angle=3.0,
+                          shift=0.02, windup_converged=True, steady_in_a_row=1)
+    save_checkpoint(tmp_path / "c.h5", {"loop": state.to_dict(), "x": np.zeros(2)}, {"t": 2.0})
+    back, _ = load_checkpoint(tmp_path / "c.h5")
+    assert ProtocolState.from_dict(back["loop"]) == state
+    assert ProtocolState.from_dict(ProtocolState().to_dict()) == ProtocolState()
+    older = {k: v for k, v in state.to_dict().items() if k not in ("t_average_from", "steady_in_a_row", "tread_angle")}
+    restored = ProtocolState.from_dict(older)
+    assert restored.t_average_from == math.inf and restored.steady_in_a_row == 0 and restored.tread_angle is None
+    with pytest.raises(ValueError, match="unknown keys"):
+        ProtocolState.from_dict({**state.to_dict(), "loop_count": 3})
+    with pytest.raises(ValueError, match="not one of"):
+        ProtocolState(phase="coast")
