@@ -82,6 +82,34 @@ def load_checkpoint(path: Path) -> tuple[dict, dict]:
 
 
 # -------------------------------------------------------------------- the run
+def _checkpoint_to_resume(out: Path, case_hash: str, *, resume: bool, restart: bool) -> tuple[dict | None, dict]:
+    """(state, meta) of the checkpoint in ``out`` to resume from, or (None, {}) for a fresh run (then the folder's
+    unfinished files are cleared). Refuses, naming what to do: --resume without a checkpoint or with another case's,
+    an unfinished run's folder without --resume or --restart, and both flags at once."""
+    result_path, ckpt_path = out / RESULT_NAME, out / CHECKPOINT_NAME
+    if resume and restart:
+        raise WheelsoilInputError("--resume and --restart exclude each other")
+    if resume:
+        if not ckpt_path.is_file():
+            done = " (the run there finished)" if result_path.is_file() else ""
+            raise WheelsoilInputError(f"nothing to resume in {out}: no checkpoint ({CHECKPOINT_NAME}){done}; "
+                                      "run without --resume")
+        state, meta = load_checkpoint(ckpt_path)
+        if meta.get("case_hash") != case_hash:
+            raise WheelsoilInputError(
+                f"the checkpoint in {out} is of another case (hash {meta.get('case_hash')}, this case {case_hash}); "
+                "resume with the same case file and --set overrides, or run without --resume")
+        return state, meta
+    if ckpt_path.is_file() and not restart:
+        _, meta = load_checkpoint(ckpt_path)
+        raise WheelsoilInputError(
+            f"{out} holds an unfinished run with a checkpoint at t = {meta.get('t', 0.0):.3f} s: --resume "
+            "continues it, --restart discards it")
+    ckpt_path.unlink(missing_ok=True)
+    partial_path(result_path).unlink(missing_ok=True)
+    return None, {}
+
+
 def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume: bool = False,
              restart: bool = False, progress: bool = False, console=None,
              bed_cache: str | Path | None = None, plan: build.RunPlan | None = None) -> RunOutcome:
@@ -106,27 +134,7 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     result_path = out / RESULT_NAME
     ckpt_path = out / CHECKPOINT_NAME
     case_hash = case.case_hash()
-    ckpt_state = None
-    if resume and restart:
-        raise WheelsoilInputError("--resume and --restart exclude each other")
-    if resume:
-        if not ckpt_path.is_file():
-            done = " (the run there finished)" if result_path.is_file() else ""
-            raise WheelsoilInputError(f"nothing to resume in {out}: no checkpoint ({CHECKPOINT_NAME}){done}; "
-                                      "run without --resume")
-        ckpt_state, meta = load_checkpoint(ckpt_path)
-        if meta.get("case_hash") != case_hash:
-            raise WheelsoilInputError(
-                f"the checkpoint in {out} is of another case (hash {meta.get('case_hash')}, this case {case_hash}); "
-                "resume with the same case file and --set overrides, or run without --resume")
-    else:
-        if ckpt_path.is_file() and not restart:
-            _, meta = load_checkpoint(ckpt_path)
-            raise WheelsoilInputError(
-                f"{out} holds an unfinished run with a checkpoint at t = {meta.get('t', 0.0):.3f} s: --resume "
-                "continues it, --restart discards it")
-        ckpt_path.unlink(missing_ok=True)
-        partial_path(result_path).unlink(missing_ok=True)
+    ckpt_state, meta = _checkpoint_to_resume(out, case_hash, resume=resume, restart=restart)
 
     bed = prepare_bed(plan.bed, cache_dir=bed_cache, progress=progress, arch=arch)
     say(f"[bold]{bed.summary()}[/bold] ({'reused from cache' if bed.meta.get('from_cache') else 'prepared'})")
