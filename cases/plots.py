@@ -14,7 +14,7 @@ def plot_series(result, path: str | Path, title: str) -> Path:
     """Forces, torque, sinkage and the slip the tread saw (with the wheel's wind-up) against time, the
     averaging window shaded.
 
-    ``result``: a :class:`~wheelsoil.coupling.testbed.TestbedResult` or :class:`~wheelsoil.cases.results.Result`
+    ``result``: a :class:`~wheelsoil.coupling.testbed_result.TestbedResult` or :class:`~wheelsoil.cases.results.Result`
     (anything with ``series`` and ``summary``; the load line is drawn from the ``load`` series).
     """
     from wheelsoil.provenance import atomic_output

@@ -159,7 +159,7 @@ def render_testbed(result, path: str | Path, **kwargs) -> Path:
     """Render the end of a testbed run: the wheel (coloured by its deformation when the result holds it) over
     the particles (coloured by speed [m/s]), heading and travel arrows, slip and steering in the title.
 
-    ``result`` is a :class:`~wheelsoil.coupling.testbed.TestbedResult`.
+    ``result`` is a :class:`~wheelsoil.coupling.testbed_result.TestbedResult`.
     """
     p = result.final_particles
     speed = np.linalg.norm(p["velocity"], axis=1)

@@ -12,7 +12,7 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
                       coupling.steady); window_start,
                       window_end [s], steady (bool), samples; + pitches (whole pitches of the tread in the
                       window), pitch_deg, commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
-    /run              + attrs: wall time, step counts, sizes (coupling.testbed.TestbedResult.info)
+    /run              + attrs: wall time, step counts, sizes (coupling.testbed_result.TestbedResult.info)
     /mesh/            nodes0 (N, 3) [m] (wheel in its start pose), triangles (T, 3), beams (B, 2)
     /frames/<k>/      attr t [s]; particles/{position, velocity (float32), radius}, wheel/{nodes,
                       + deflection (float32: node position less the wheel's best-fit rigid motion of

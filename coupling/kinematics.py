@@ -97,3 +97,9 @@ def slip_angle_deg(velocity, heading, axle) -> float:
     v[2] = 0.0
     vx, vy = float(v @ heading), float(v @ axle)
     return math.degrees(math.atan2(vy, vx)) if math.hypot(vx, vy) > 1e-12 else 0.0
+
+
+def yaw_matrix(angle_rad: float) -> np.ndarray:
+    """The rotation [3 x 3] by ``angle_rad`` about the vertical (z) axis."""
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

@@ -290,3 +290,11 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
             "periodic bed (soil.periodic = true: a moving soil patch holds any drive)"
         )
     return start_x
+
+
+def batch_rate(slip: float, reference_spin: float, radius: float) -> float:
+    """The rate [rad/s] at which the steady-state statistics' batches (pitches) pass under the rig's command:
+    the hub's commanded spin (:func:`.kinematics.rig_command`), or for a wheel dragged without turning (i = -1)
+    the angle it would roll through at its travel speed, v_x / r."""
+    spin, heading_speed = rig_command(slip, reference_spin, radius)
+    return spin if spin > 0.0 else heading_speed / radius

@@ -54,51 +54,27 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh
-from wheelsoil.flexwheel.mesh import StructureMesh
 from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed
 
 from .contact import WheelContact
-from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg
+from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg, yaw_matrix
 from .patch import MovingPatch
 from .protocol_state import ProtocolState
-from .rig import RigPlan, TestbedSpec, batches_per_period, carriage_speed, plan_rig, soil_headroom, statistics_pitch
-from .run_summary import SERIES_UNITS, STEADY_CHECKED, STEADY_QUANTITIES, QuantityStats, RunSummary
-from .steady import SteadyState, confirm_steady, detect_steady_state, window_stats
-
-
-def yaw_matrix(angle_rad: float) -> np.ndarray:
-    c, s = math.cos(angle_rad), math.sin(angle_rad)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-@dataclass
-class TestbedResult:
-    """Time series (NumPy arrays, units in :data:`SERIES_UNITS`) and the steady-state summary."""
-
-    __test__ = False
-
-    series: dict
-    summary: RunSummary
-    spec: TestbedSpec
-    wheel: WheelGeometry
-    bed_summary: str
-    info: dict = field(default_factory=dict)
-    final_particles: dict = field(default_factory=dict)
-    final_wheel_nodes: np.ndarray | None = None
-    final_deformation: np.ndarray | None = None
-    mesh: StructureMesh | None = None
-
-    def steady(self, name: str) -> float:
-        """Steady-state mean of a quantity (see :data:`~.run_summary.SUMMARY_QUANTITIES`)."""
-        return self.summary.mean(name)
+from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig, soil_headroom,
+                  statistics_pitch)
+from .run_progress import RunProgress
+from .run_statistics import detect_from_rows, summarise_window
+from .run_summary import SERIES_UNITS
+from .steady import SteadyState, confirm_steady
+from .testbed_result import TestbedResult
 
 
 class Testbed:
@@ -242,7 +218,7 @@ class Testbed:
         if self._loop.phase == "done":
             raise WheelsoilInputError("this testbed has finished its run; build a new Testbed to run again")
         wall = time.perf_counter() - self._loop.wall
-        bar = _ProgressBar(self) if progress else None
+        bar = RunProgress(self) if progress else None
         try:
             while not self._sample():
                 if bar is not None:
@@ -264,6 +240,11 @@ class Testbed:
         self.rows = {k: [] for k in SERIES_UNITS}
         self.structure.drive_hub(velocity=(0.0, 0.0, -s.lowering_speed), free_translation=(False, False, False))
         self.contact.mean_resultant(reset=True)
+
+    @property
+    def protocol_state(self) -> ProtocolState | None:
+        """Where the run's protocol stands (None before :meth:`run`)."""
+        return self._loop
 
     @property
     def phase(self) -> str:
@@ -467,31 +448,9 @@ class Testbed:
         if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
             k1 = len(t)
             k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
-        quantities = {}
-        for q in STEADY_QUANTITIES:
-            y = rows[q][k0:k1]
-            st = state.stats.get(q)
-            if st is None and len(state.bounds) > 2 and (state.bounds[-1], state.bounds[0]) == (k0, k1):
-                # batch means over the same pitches
-                st = window_stats(np.asarray(rows[q], float), state.bounds, period=self.period_pitches)
-            st = st or {}
-            quantities[q] = QuantityStats(
-                mean=float(np.mean(y)), std=float(np.std(y)), sem=float(st.get("sem", math.nan)),
-                ci95=float(st.get("ci95", math.nan)), dof=float(st.get("dof", math.nan)),
-                drift=float(st.get("drift", math.nan)), drift_sem=float(st.get("drift_sem", math.nan)),
-                units=SERIES_UNITS[q],
-                zero_within_noise=bool(st["zero_within_noise"]) if "zero_within_noise" in st else None)
-        ts = state.stats.get("tread_slip")
-        if ts is not None:
-            quantities["tread_slip"] = QuantityStats(**{k: float(v) for k, v in ts.items()}, units="1")
-        else:
-            y = rows["tread_slip"][k0:k1]
-            quantities["tread_slip"] = QuantityStats(float(np.mean(y)), float(np.std(y)), units="1")
-        summary = RunSummary(
-            steady=bool(state.steady), window=(float(t[k0] - self.steps_per_sample * self.dt), float(t[k1 - 1])),
-            samples=int(k1 - k0), pitches=int(state.pitches), pitch_deg=math.degrees(self.pitch),
-            period_pitches=self.period_pitches, reasons=tuple(state.reasons), commanded_slip=s.slip,
-            commanded_slip_angle=s.slip_angle, **quantities)
+        summary = summarise_window(rows, state, k0, k1, period_pitches=self.period_pitches,
+                                   sample_interval=self.steps_per_sample * self.dt, pitch=self.pitch,
+                                   commanded_slip=s.slip, commanded_slip_angle=s.slip_angle)
         particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
         nodes = self.structure.positions()
         info = {
@@ -525,85 +484,3 @@ class Testbed:
         weights = np.maximum(self.structure.mass, 0.0)
         weights[self.structure.hub_nodes] += self.wheel.hub_mass / max(len(self.structure.hub_nodes), 1)
         return deformation(nodes, self.mesh.nodes, weights)
-
-
-class _ProgressBar:
-    """The run's progress on the terminal (rich): phase, time, forces and the tread's slip."""
-
-    def __init__(self, bench: Testbed) -> None:
-        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
-        self.bench = bench
-        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
-                            TimeElapsedColumn(), transient=True)
-        self.bar.start()
-        self.task = self.bar.add_task("testbed", total=None)
-
-    def update(self) -> None:
-        b, rows = self.bench, self.bench.rows
-        loop, s = b._loop, b.spec
-        total = completed = None
-        if math.isfinite(loop.t_spin):
-            end = loop.t_spin + s.spin_up_time + s.drive_time
-            total, completed = 1000, int(1000 * min(1.0, (b.scene.time - loop.t_release) / (end - loop.t_release)))
-        text = (f"{loop['phase']:8s} t = {b.scene.time:.3f} s  DP {rows['drawbar_pull'][-1]:8.1f} N  "
-                f"Fz {rows['vertical_force'][-1]:8.1f} N  T {rows['torque'][-1]:7.1f} N m  "
-                f"sinkage {1e3 * rows['sinkage'][-1]:6.1f} mm")
-        if loop.phase in ("wind-up", "drive"):
-            n = max(1, int(b.pitch / b.batch_rate / (b.steps_per_sample * b.dt)))
-            omega_t = float(np.mean(rows["tread_omega"][-n:]))
-            slip = longitudinal_slip(b.slip_reference_speed, omega_t, b.wheel.radius)
-            text += f"  tread slip {slip:.3f} (commanded {s.slip:g})"
-        self.bar.update(self.task, total=total, completed=completed, description=text)
-
-    def stop(self) -> None:
-        self.bar.stop()
-
-
-def batch_rate(slip: float, reference_spin: float, radius: float) -> float:
-    """The rate [rad/s] at which the steady-state statistics' batches (pitches) pass under the rig's command:
-    the hub's commanded spin (:func:`.kinematics.rig_command`), or for a wheel dragged without turning (i = -1)
-    the angle it would roll through at its travel speed, v_x / r."""
-    spin, heading_speed = rig_command(slip, reference_spin, radius)
-    return spin if spin > 0.0 else heading_speed / radius
-
-
-def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: float, average_time: float,
-                     steady_tolerance: float, slip_tolerance: float, radius: float, pitch: float,
-                     mean_diameter: float, sample_interval: float, start: float, period_pitches: int = 1,
-                     truncation_search: float = 0.5) -> SteadyState:
-    """The testbed's steady-state verdict on its series ``rows`` (name -> per-sample values, the columns of
-    :data:`SERIES_UNITS`) -- what a running testbed asks once per pitch, and what a stored run's ``series.csv``
-    can be asked again (``docs/steady_replay.py``).
-
-    slip, load [N], angular_velocity [rad/s] (the reference spin), average_time [s], steady_tolerance,
-    slip_tolerance: the rig's settings (:class:`TestbedSpec`); radius [m], pitch [rad] (the batch: :func:`statistics_pitch`) and
-    period_pitches (its whole period in batches): the wheel's; mean_diameter [m]: the soil's mean particle
-    diameter (half of it is the sinkage's floor); sample_interval [s]; start [s]: earliest window start.
-    The floors of the relative tolerance are 5 % of W for the forces, 5 % of W r for the torque.
-    truncation_search: see :func:`~.steady.detect_steady_state`.
-    """
-    series = {q: np.asarray(rows[q], float) for q in STEADY_CHECKED}
-    floors = {"drawbar_pull": 0.05 * load, "lateral_force": 0.05 * load, "vertical_force": 0.05 * load,
-              "torque": 0.05 * load * radius, "sinkage": 0.5 * mean_diameter}
-    t = np.asarray(rows["t"], float)
-    # the tread angle from its per-sample spin, and the speed the tread slip is taken against (recorded; a
-    # series stored before it was, from runs that only drove, recovered from i_t = 1 - v_x / (r omega_t))
-    omega_t = np.asarray(rows["tread_omega"], float)
-    if "slip_speed" in rows:
-        heading_speed = np.asarray(rows["slip_speed"], float)
-    else:
-        heading_speed = (1.0 - np.asarray(rows["tread_slip"], float)) * radius * omega_t
-    angle = np.cumsum(omega_t * sample_interval)
-    rate = batch_rate(slip, angular_velocity, radius)
-    # a dragged wheel does not turn: its batches are the angles it would roll through at the speed its slip is
-    # taken against (batch_rate)
-    batch_angle = angle if rig_command(slip, angular_velocity, radius)[0] > 0.0 else \
-        np.cumsum(heading_speed * sample_interval) / radius
-    min_pitches = int(math.ceil(average_time * rate / pitch))
-    return detect_steady_state(
-        t, series, tread_angle=angle, batch_angle=batch_angle, travel_speed=heading_speed, radius=radius,
-        pitch=pitch, start=start,
-        min_pitches=min_pitches, tolerance=steady_tolerance, floors=floors, slip_target=slip,
-        slip_tolerance=slip_tolerance, sample_interval=sample_interval, period_pitches=period_pitches,
-        truncation_search=truncation_search)

@@ -2,7 +2,7 @@
 
 A run's ``series.csv`` holds every sample the detector saw, and its ``summary.json`` when the drive was held,
 so the detector's checks can be replayed exactly as :class:`wheelsoil.coupling.testbed.Testbed` makes them
-(:func:`wheelsoil.coupling.testbed.detect_from_rows`, first one pitch plus ``average_time`` after the hold,
+(:func:`wheelsoil.coupling.run_statistics.detect_from_rows`, first one pitch plus ``average_time`` after the hold,
 then once per pitch, ``steady_checks`` steady verdicts in a row ending the run) -- with the detector of the
 installed wheelsoil, or with its MSER search up to the shortest window (``--truncation-search 1``, the search
 before the first-half rule) and every batch taken for a whole period of the wheel (``--batch-is-period``, as
@@ -26,7 +26,7 @@ import numpy as np
 from wheelsoil.cases import build
 from wheelsoil.cases.schema import load_case
 from wheelsoil.coupling.steady import confirm_steady
-from wheelsoil.coupling.testbed import detect_from_rows
+from wheelsoil.coupling.run_statistics import detect_from_rows
 from wheelsoil.coupling.rig import batches_per_period, statistics_pitch
 
 
