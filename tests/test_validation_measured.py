@@ -89,6 +89,23 @@ def test_bad_files_name_the_problem(tmp_path):
         missing.write_text(header + "grouser,0,0.2,1,1,20,5\n" + bad + "\n")
         with pytest.raises(WheelsoilInputError, match=match):
             load_cmu_trials(tmp_path)
+    # the rig's speeds tell a braked wheel from a dragged one: a braking row needs both, and they must agree with the slip
+    speeds = "wheel,steering_angle_deg,rim_speed_mm_s,carriage_speed_mm_s,slip,drawbar_pull_N,lateral_force_N," \
+             "vertical_load_N,sinkage_mm\n"
+    good = "grouser,0,20,10,0.5,1,1,20,5\ngrouser,0,0,10,-1,-40,1,20,50\ngrouser,0,5,10,-0.5,-17,1,20,20\n"
+    (tmp_path / "smooth_wheel_trials.csv").write_text(header + "smooth,0,0.2,1,1,20,5\n")
+    missing.write_text(speeds + good)
+    assert len(load_cmu_trials(tmp_path)) == 4  # the smooth file's row and the three
+    for bad, match in (("grouser,0,,10,-0.5,-17,1,20,20", r"column 'rim_speed' is empty in braking data row 4 "),
+                       ("grouser,0,5,,-0.5,-17,1,20,20", r"column 'carriage_speed' is empty in braking data row 4 "),
+                       ("grouser,0,5,10,-1,-40,1,20,50", r"data row 4 has slip -1 with column 'rim_speed' 0.005 m/s"),
+                       ("grouser,0,0,10,-0.5,-17,1,20,20", r"data row 4 has slip -0.5 with column 'rim_speed' 0 m/s")):
+        missing.write_text(speeds + good + bad + "\n")
+        with pytest.raises(WheelsoilInputError, match=match):
+            load_cmu_trials(tmp_path)
+    missing.write_text(speeds.replace("carriage_speed_mm_s,", "").replace(",10,", ",") + "grouser,0,20,0.5,1,1,20,5\n")
+    with pytest.raises(WheelsoilInputError, match="has the column 'rim_speed' but not 'carriage_speed'"):
+        load_cmu_trials(tmp_path)
 
 
 def test_sweep_summary_reads_as_simulated_data_and_a_partial_table_is_refused(tmp_path):
