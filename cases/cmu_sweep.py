@@ -32,19 +32,22 @@ SUBSET = {"grouser": (0.0, 45.0, 90.0), "smooth": (0.0, 90.0)}
 SUBSET_SLIPS = (-1.0, -0.5, 0.0, 0.5, 0.9)
 SUBSET_TRIAL = 1
 
+def _particles(pair, material) -> dict:
+    """The case overrides that give the twin's soil another calibrated particle set: its sliding and rolling friction
+    and the density that packs it to the sand's bulk density (the restitution, stiffness and sizes stay the twin's)."""
+    return {"soil.static_friction": pair.static_friction, "soil.rolling_friction": pair.rolling_friction,
+            "soil.density": material.density}
+
+
 #: The DEM-side candidates for what the twin gets wrong, each a name -> (case overrides, why), calibrated on the soil
 #: lab alone and fixed before their runs (docs/cmu-twin/README.md, "Candidates").
 CANDIDATES = {
     "plate-soil": (
-        {"soil.static_friction": cmu_sand.PLATE_FIT_PAIR.static_friction,
-         "soil.rolling_friction": cmu_sand.PLATE_FIT_PAIR.rolling_friction,
-         "soil.density": cmu_sand.PLATE_FIT_MATERIAL.density},
+        _particles(cmu_sand.PLATE_FIT_PAIR, cmu_sand.PLATE_FIT_MATERIAL),
         "The soil calibrated on the sand's plates alone (wheelsoil.parameters.cmu_sand.PLATE_FIT_PAIR): the shear\n"
         "box's peak 39 deg and 0.9 kPa against the chosen soil's 45 deg and 2.9 kPa."),
     "rolling-fit": (
-        {"soil.static_friction": cmu_sand.MID_FIT_PAIR.static_friction,
-         "soil.rolling_friction": cmu_sand.MID_FIT_PAIR.rolling_friction,
-         "soil.density": cmu_sand.MID_FIT_MATERIAL.density},
+        _particles(cmu_sand.MID_FIT_PAIR, cmu_sand.MID_FIT_MATERIAL),
         "Between the two lab soils (wheelsoil.parameters.cmu_sand.MID_FIT_PAIR): sliding 0.51 and rolling 0.22, the\n"
         "fraction 0.69 of the way from the chosen soil to the plate-only one fitted on the seen 0-deg driving trial."),
     "particle-scale": (
