@@ -65,21 +65,26 @@ CANDIDATE_SLIPS = (0.5, 0.9)
 REPLICA_CONDITION = ("grouser", 0.0, 0.5)
 
 
-def drive_time(slip: float, test) -> float | None:
-    """The drive [s] a braked or dragged trial needs, or None for the preset's (6 s, enough driving).
+#: The twin's drive [s]: what the steady detector needs in the twin's noise (the drawbar pull's pitch means scatter by
+#: about 2.5 N against the 0.9 N of drift it allows): on synthetic runs of that regime (docs/steady_twin_regime.py,
+#: docs/cmu-twin/steady-regime.md) a 6 s drive calls a stationary run steady in 25 % of seeds and a run drifting by
+#: 10 % of its mean per second in 22 %, no better than chance; 20 s calls 97 % of stationary runs steady. Fixed on
+#: 2026-11-27 from that campaign, before any twin run at 45 or 90 deg was steady.
+TWIN_DRIVE_TIME = 20.0
+
+
+def drive_time(slip: float, test) -> float:
+    """The drive [s] of a trial's case: :data:`TWIN_DRIVE_TIME`, or longer where a braked wheel turns too slowly.
 
     The steady detector judges a run by pitches of the tread's rotation: one revolution first, then a window of at
     least ``output.average_time`` checked twice half a revolution apart (the wheel's period), so about 3 pi / omega
-    of drive. Braking at travel slip i the hub turns at omega_0 (1 + i): at i = -0.5, 10.9 s of drive, against the
-    preset's 6 s, which left the first braking run of the subset short of one revolution. The dragged wheel does not
-    turn (its pitches are those of its travel) and was still sinking after 6 s: it gets twice the preset's drive.
-    ``test``: the ``[test]`` section of the sweeps' base preset (``cmu-grouser``)."""
-    if slip >= 0.0:
-        return None
-    if slip <= -1.0:
-        return 2.0 * test.drive_time
-    need = 3.0 * math.pi / (test.angular_velocity * (1.0 + slip)) + test.spin_up_time
-    return round(need, 1) if need > test.drive_time else None
+    of drive. Braking at travel slip i the hub turns at omega_0 (1 + i): at i = -0.5, 10.9 s; a dragged wheel does
+    not turn (its pitches are those of its travel). ``test``: the ``[test]`` section of the sweeps' base preset
+    (``cmu-grouser``)."""
+    if -1.0 < slip < 0.0:
+        need = 3.0 * math.pi / (test.angular_velocity * (1.0 + slip)) + test.spin_up_time
+        return max(TWIN_DRIVE_TIME, round(need, 1))
+    return TWIN_DRIVE_TIME
 
 
 def trial_rows(folder: str | Path) -> list[dict]:
@@ -106,9 +111,7 @@ def trial_rows(folder: str | Path) -> list[dict]:
                 rows.append({"wheel.preset": f"cmu-k10-{wheel}", "case.seed": repeats[condition],
                              "test.slip": float(row["slip"]), "test.slip_angle": float(row["steering_angle_deg"]),
                              "test.load": float(row["vertical_load_N"])})
-                drive = drive_time(float(row["slip"]), base)
-                if drive is not None:
-                    rows[-1]["test.drive_time"] = drive
+                rows[-1]["test.drive_time"] = drive_time(float(row["slip"]), base)
     return rows
 
 
@@ -128,10 +131,10 @@ def _pick(rows: list[dict], wheels: dict, slips: tuple) -> list[dict]:
 
 
 def subset(rows: list[dict]) -> list[dict]:
-    """The rows of :data:`SUBSET`, those with the preset's drive first (free rolling and driving), the braked and
-    dragged ones, which drive about twice as long, after them: the order is the sweep's schedule only."""
+    """The rows of :data:`SUBSET`, the free-rolling and driving ones first, the braked and dragged ones after them:
+    the order is the sweep's schedule only."""
     picked = _pick(rows, SUBSET, SUBSET_SLIPS)
-    return [r for r in picked if "test.drive_time" not in r] + [r for r in picked if "test.drive_time" in r]
+    return [r for r in picked if r["test.slip"] >= 0.0] + [r for r in picked if r["test.slip"] < 0.0]
 
 
 def replica_rows(rows: list[dict]) -> list[dict]:
@@ -174,8 +177,8 @@ def write_presets(folder: str | Path, presets: str | Path | None = None) -> list
     rows = trial_rows(folder)
     common = ("Written by `python -m wheelsoil.cases.cmu_sweep ../shared/data/measured/cmu_3d_terramechanics`\n"
               "(wheelsoil.cases.cmu_sweep): one case per trial at its steering angle, slip and measured mean load;\n"
-              "its repeat at its condition is the bed's seed. About 25 min a case on 2 cores, one at a time (--workers 1;\n"
-              "benchmarks/README.md); a GPU: wheelsoil batch --arch.")
+              "its repeat at its condition is the bed's seed; TWIN_DRIVE_TIME (20 s) of drive, stopped once steady: up to\n"
+              "about 80 min a case on 2 cores, one at a time (--workers 1; benchmarks/README.md); a GPU: wheelsoil batch --arch.")
     paths = []
     sweeps = [("cmu-trials", rows, f"The CMU single-wheel trials, all {len(rows)}, as DEM-FEM cases.", None),
               ("cmu-trials-subset", subset(rows), "A subset of the CMU trials fixed before any result (cases/cmu_sweep.py "
