@@ -54,7 +54,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -67,13 +66,14 @@ from wheelsoil.granular.bed import Bed
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg, yaw_matrix
 from .patch import MovingPatch
+from .protocol import DEFAULT_PROTOCOL, advance, step_named
 from .protocol_state import ProtocolState
 from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig, soil_headroom,
                   statistics_pitch)
 from .run_progress import RunProgress
 from .run_statistics import detect_from_rows, summarise_window
 from .run_summary import SERIES_UNITS
-from .steady import SteadyState, confirm_steady
+from .steady import SteadyState
 from .testbed_result import TestbedResult
 
 
@@ -183,6 +183,8 @@ class Testbed:
         self._loop: ProtocolState | None = None
         self.rows: dict | None = None
         self.steady_state: SteadyState | None = None
+        #: the rig's protocol, a list of steps (:mod:`.protocol`); the run's state is :attr:`protocol_state`
+        self.protocol = DEFAULT_PROTOCOL
 
     # ------------------------------------------------------------------ the rig's commands
     @property
@@ -194,7 +196,7 @@ class Testbed:
         """Spin the hub at ``hub_spin`` about the axle and move the carriage at ``carriage`` along the bin."""
         self.structure.drive_hub(velocity=(carriage, 0.0, 0.0), angular_velocity=hub_spin * self.axle)
 
-    def _release(self) -> None:
+    def release(self) -> None:
         """Free the axle vertically under the load W (the rig applies W - m g downwards)."""
         self.structure.set_hub_state(velocity=(0.0, 0.0, 0.0))
         self.structure.drive_hub(free_translation=(False, False, True))
@@ -252,23 +254,12 @@ class Testbed:
         return self._loop.phase if self._loop else "new"
 
     def _set_drive(self) -> None:
-        """The hub's spin and the carriage's speed for the sample about to be taken."""
-        s, loop = self.spec, self._loop
-        t = self.scene.time
-        phase = loop.phase
-        omega = self.spin_command
-        if phase == "spin-up":
-            ramp = min(1.0, (t - loop.t_spin) / s.spin_up_time) if s.spin_up_time > 0 else 1.0
-            spin, carriage = omega * ramp, self.travel_speed * ramp
-        elif phase == "wind-up":
-            spin = omega + s.windup_gain * (omega - loop.omega_filtered)
-            spin, carriage = min(max(spin, 0.5 * omega), 1.5 * omega), self.travel_speed
-        elif phase == "drive":
-            spin, carriage = omega, self.travel_speed
-        else:
-            return
-        loop.hub_spin = spin
-        self._command(spin, carriage)
+        """The hub's spin and the carriage's speed for the sample about to be taken, from the running step."""
+        loop = self._loop
+        command = step_named(self.protocol, loop.phase).command(self, loop, self.scene.time)
+        if command is not None:
+            loop.hub_spin = command[0]
+            self._command(*command)
 
     def _sample(self) -> bool:
         """Advance one sample interval, record it and move the protocol on; True when the run is over."""
@@ -293,7 +284,7 @@ class Testbed:
                 "lower load or slip, or a larger test.max_wind_up if the twist is real")
         if self.patch is not None and phase != "lower":
             loop.shift += self.patch.update(self)
-        return self._advance_phase(row)
+        return advance(self.protocol, self, loop, row, self.scene.time)
 
     def _measure(self, phase: str, interval: float) -> dict:
         s, loop = self.spec, self._loop
@@ -335,72 +326,8 @@ class Testbed:
             "contacts": self.contact.contact_count,
         }
 
-    def _advance_phase(self, row: dict) -> bool:
-        s, loop = self.spec, self._loop
-        t = self.scene.time
-        phase = loop.phase
-        if phase == "lower":
-            if row["vertical_force"] >= s.load:
-                self._release()
-                loop.phase, loop.t_release = "settle", t
-            elif row["sinkage"] > 0.5 * self.wheel.radius:
-                raise SimulationUnstableError(
-                    f"the bed does not carry the load {s.load} N: the wheel sank {row['sinkage']:.3f} m "
-                    f"(more than half its radius) while lowered, with the soil carrying {row['vertical_force']:.1f} N")
-        elif phase == "settle" and t >= loop.t_release + s.settle_time - 1e-12:
-            loop.phase, loop.t_spin = "spin-up", t
-            loop.omega_filtered = 0.0
-        elif phase == "spin-up" and t >= loop.t_spin + s.spin_up_time - 1e-12:
-            loop.t_windup = t
-            if s.windup == "controller" and not s.rigid:  # a rigid wheel has nothing to wind up
-                loop.phase = "wind-up"
-            else:
-                self._hold(t)
-        elif phase == "wind-up":
-            if self._wound_up() or t >= loop.t_windup + 0.5 * s.drive_time:
-                loop.windup_converged = self._wound_up()
-                self._hold(t)
-        elif phase == "drive" and t >= loop.next_check - 1e-12:
-            loop.next_check = t + self.pitch / self.batch_rate
-            ended = t >= loop.t_windup + s.drive_time - 1e-12
-            if s.stop_when_steady or ended:
-                state = self._detect()
-                if state.steady and not self._window_long_enough(state):
-                    state = replace(state, steady=False, reasons=["the steady window is shorter than average_time"])
-                self.steady_state, loop.steady_in_a_row = confirm_steady(
-                    state, loop.steady_in_a_row, s.steady_checks)
-                done = self.steady_state.steady
-                if (done and s.stop_when_steady) or ended:
-                    return True
-        return False
-
-    def _hold(self, t: float) -> None:
-        """End the wind-up: from now on the hub spins at exactly omega."""
-        loop = self._loop
-        loop.phase, loop.t_hold = "drive", t
-        # the first window may start one whole period after the hold (the hub's step from the controller's
-        # spin to omega is a small disturbance the wheel rides out within a period)
-        loop.t_average_from = t + self.pitch / self.batch_rate
-        loop.next_check = loop.t_average_from + self.spec.average_time
-
-    def _wound_up(self) -> bool:
-        """The tread's spin over its last pitch gives the commanded slip within a third of the tolerance, and
-        the controller's hub spin gives it within the tolerance (slips at the commanded travel speed)."""
-        s, rows = self.spec, self.rows
-        omega_t = np.asarray(rows["tread_omega"])
-        t = np.asarray(rows["t"])
-        n_pitch = int(math.ceil(self.pitch / self.batch_rate / (self.steps_per_sample * self.dt)))
-        if len(t) < n_pitch or t[-n_pitch] < self._loop.t_windup:
-            return False
-        r, v = self.wheel.radius, self.slip_reference_speed
-        slip_error = abs(longitudinal_slip(v, float(omega_t[-n_pitch:].mean()), r) - s.slip)
-        spin_error = abs(longitudinal_slip(v, self._loop.hub_spin, r) - s.slip)
-        return slip_error <= s.slip_tolerance / 3.0 and spin_error <= s.slip_tolerance
-
-    def _window_long_enough(self, state: SteadyState) -> bool:
-        return state.window[1] - state.window[0] >= self.spec.average_time * (1.0 - 1e-9)
-
-    def _detect(self) -> SteadyState:
+    def detect(self) -> SteadyState:
+        """The steady-state detector's verdict on the rows so far (:func:`~.run_statistics.detect_from_rows`)."""
         s = self.spec
         return detect_from_rows(
             self.rows, slip=s.slip, load=s.load, angular_velocity=s.angular_velocity, average_time=s.average_time,
@@ -442,7 +369,7 @@ class Testbed:
     # ------------------------------------------------------------------ the result
     def _result(self, rows: dict, wall: float) -> TestbedResult:
         s, loop = self.spec, self._loop
-        state = self.steady_state if self.steady_state is not None else self._detect()
+        state = self.steady_state if self.steady_state is not None else self.detect()
         t = rows["t"]
         k0, k1 = state.k0, state.k1
         if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady

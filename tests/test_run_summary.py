@@ -67,3 +67,25 @@ def test_the_protocol_state_round_trips_through_a_checkpoint_and_refuses_unknown
         ProtocolState.from_dict({**state.to_dict(), "loop_count": 3})
     with pytest.raises(ValueError, match="not one of"):
         ProtocolState(phase="coast")
+
+
+def test_the_default_protocol_is_its_five_steps_and_skips_the_wind_up_of_a_rigid_wheel():
+    """The protocol as data: lower, settle, spin-up, wind-up, drive; the wind-up applies to a flexible wheel with
+    the controller only, so a rigid wheel goes from the spin-up straight to the drive, which begins at that moment."""
+    from types import SimpleNamespace
+
+    from wheelsoil.coupling.protocol import DEFAULT_PROTOCOL, advance
+    from wheelsoil.coupling.protocol_state import PHASES, ProtocolState
+
+    assert [s.name for s in DEFAULT_PROTOCOL] == list(PHASES[1:-1])
+    for rigid, windup, expected in ((True, "controller", "drive"), (False, "none", "drive"),
+                                    (False, "controller", "wind-up")):
+        spec = SimpleNamespace(rigid=rigid, windup=windup, spin_up_time=0.5, average_time=1.0)
+        bench = SimpleNamespace(spec=spec, pitch=0.5, batch_rate=2.0)
+        state = ProtocolState(phase="spin-up", t_spin=1.0)
+        assert not advance(DEFAULT_PROTOCOL, bench, state, {}, 1.2)  # the ramp goes on
+        assert state.phase == "spin-up"
+        assert not advance(DEFAULT_PROTOCOL, bench, state, {}, 1.5)
+        assert state.phase == expected and state.t_windup == 1.5
+        if expected == "drive":  # the hold: the first window a pitch later, checked average_time after that
+            assert (state.t_hold, state.t_average_from, state.next_check) == (1.5, 1.75, 2.75)
