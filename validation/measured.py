@@ -22,6 +22,8 @@ from wheelsoil.gravity import EARTH_GRAVITY, gravity_label
 from wheelsoil.parameters import cmu_k10
 from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
+from .cmu_rows import check_cmu_rows
+
 #: unit suffix -> (SI unit, factor to SI); longest suffix wins (``_mm_s`` before ``_s``).
 UNITS = {
     "_m_s2": ("m/s^2", 1.0),
@@ -214,13 +216,7 @@ def load_cmu_file(path: str | Path, *, domain: str = "all") -> Measurements:
     n = len(group)
     col = lambda key: np.asarray(t.columns[key], float)  # noqa: E731
     opt = lambda key: col(key) if key in t.columns else np.full(n, np.nan)  # noqa: E731
-    for key, lo, hi, unit in (("slip", -1.0, 1.0, ""), ("steering_angle", -90.0, 90.0, " deg")):
-        bad = np.flatnonzero(~((col(key) >= lo) & (col(key) <= hi)))
-        if bad.size:
-            raise WheelsoilInputError(f"{path}: column {key!r} holds {col(key)[bad[0]]:g}{unit} in data row "
-                                      f"{bad[0] + 1} ({bad.size} such row(s)); the rig's {key} lies in "
-                                      f"[{lo:g}, {hi:g}]{unit}")
-    _check_rig_speeds(t, path, col("slip"))
+    check_cmu_rows(t, path)
     data = Measurements(
         name=Path(path).stem,
         slip=heading_slip_from_travel(col("slip"), col("steering_angle")), slip_angle=col("steering_angle"),
@@ -239,36 +235,6 @@ def load_cmu_file(path: str | Path, *, domain: str = "all") -> Measurements:
     data, counts = in_domain(data, domain)
     data.notes = f"{CMU_NOTES}; {counts}"
     return data
-
-
-def _check_rig_speeds(t: Table, path, slip: np.ndarray) -> None:
-    """Where a file records the rig's speeds (``rim_speed``, ``carriage_speed``), they are what tells a braked wheel
-    (its rim turning slower than the carriage moves) from a dragged one (its rim at rest, slip -1): a braking row
-    (slip < 0) needs both, and a dragged row's rim must be at rest and a braked row's not. A row that lacks them or
-    disagrees is refused, naming the file, the data row and the column. A file with neither column is read by its
-    slip alone."""
-    present = [k for k in ("rim_speed", "carriage_speed") if k in t.columns]
-    if not present:
-        return
-    if len(present) == 1:
-        raise WheelsoilInputError(f"{path}: has the column {present[0]!r} but not "
-                                  f"{({'rim_speed', 'carriage_speed'} - set(present)).pop()!r}: the rig's speeds come "
-                                  "as a pair (together they tell a braked wheel from a dragged one)")
-    braking = slip < 0.0
-    for key in present:
-        bad = np.flatnonzero(braking & ~np.isfinite(np.asarray(t.columns[key], float)))
-        if bad.size:
-            raise WheelsoilInputError(
-                f"{path}: column {key!r} is empty in braking data row {bad[0] + 1} ({bad.size} such row(s)); a braking "
-                "row needs the rim and carriage speeds that tell a braked wheel (its rim turning slower than the "
-                "carriage) from a dragged one (its rim at rest, slip -1)")
-    rim = np.asarray(t.columns["rim_speed"], float)
-    wrong = np.flatnonzero(braking & ((slip <= -1.0) != (rim == 0.0)))
-    if wrong.size:
-        k = wrong[0]
-        raise WheelsoilInputError(
-            f"{path}: data row {k + 1} has slip {slip[k]:g} with column 'rim_speed' {rim[k]:g} m/s ({wrong.size} such "
-            "row(s)): a dragged wheel (slip -1) has its rim at rest, a braked one (-1 < slip < 0) a turning rim")
 
 
 #: The row sets ``wheelsoil validate --domain`` may keep: every row, or the classical driving branch.
