@@ -157,6 +157,7 @@ def _non_blank(image: np.ndarray) -> bool:
     return image.std() > 10 and len(colours) > 50
 
 
+@pytest.mark.slow  # 10 s of rendering; the layout and resume tests stay fast
 def test_render_of_a_frame_and_an_animation(reference, tmp_path):
     import imageio.v2 as imageio
 

@@ -9,6 +9,10 @@ from wheelsoil.granular import BedSpec, Material, PairProperties
 from wheelsoil.soillab import PlateSpec, ShearSpec, plate_test, poured_bed_test, shear_test
 from wheelsoil.soillab.penetration import resting_plate
 
+#: The slow tier: about 75 s of small DEM tests on 2 cores, which kept the fast tier over its 5 minutes (the soil
+#: lab's plain parts, fits and errors stay fast: tests/test_soillab_plain.py).
+pytestmark = pytest.mark.slow
+
 SOIL = Material("test particles", youngs_modulus=5e7, poisson_ratio=0.3, density=2300.0)
 PAIR = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.1)
 
@@ -20,7 +24,7 @@ def small_bed(seed=0, **kw):
     return BedSpec(**values)
 
 
-@pytest.mark.parametrize("mass", [0.5, pytest.param(2.0, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("mass", [0.5, 2.0])
 def test_plate_at_rest_carries_its_own_weight(bed_cache, mass):
     """Laid on the bed and left under gravity, the soil's force on the plate over the last quarter of a 0.25 s rest
     equals its weight (to 2 %: what the rest's last motion leaves; the plate comes to rest within about 0.1 s)."""
