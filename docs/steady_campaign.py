@@ -59,16 +59,18 @@ CORRELATION = 0.05  # AR(1) correlation time [s]
 GROUSER = 50.0  # amplitude of the grouser component [N]
 
 
-def red_noise(rng, n: int, sigma_pitch: float) -> np.ndarray:
-    """AR(1) noise whose means over one pitch scatter by ``sigma_pitch``: with unit variance and lag-one
-    correlation phi, a mean of N samples has variance ((1 + phi) / (1 - phi) - 2 phi (1 - phi^N) / (N (1 - phi)^2)) / N."""
-    phi = math.exp(-DT / CORRELATION)
+def red_noise(rng, n: int, sigma_pitch: float, *, dt: float = DT, pitch_time: float = PITCH / OMEGA,
+              correlation: float = CORRELATION) -> np.ndarray:
+    """AR(1) noise (correlation time ``correlation`` [s], samples ``dt`` apart) whose means over one pitch
+    (``pitch_time`` [s]) scatter by ``sigma_pitch``: with unit variance and lag-one correlation phi, a mean of N
+    samples has variance ((1 + phi) / (1 - phi) - 2 phi (1 - phi^N) / (N (1 - phi)^2)) / N."""
+    phi = math.exp(-dt / correlation)
     e = rng.normal(0.0, math.sqrt(1.0 - phi * phi), n)
     x = np.empty(n)
     x[0] = rng.normal()
     for k in range(1, n):
         x[k] = phi * x[k - 1] + e[k]
-    n_pitch = PITCH / OMEGA / DT
+    n_pitch = pitch_time / dt
     var_mean = ((1.0 + phi) / (1.0 - phi) - 2.0 * phi * (1.0 - phi ** n_pitch) / (n_pitch * (1.0 - phi) ** 2)) / n_pitch
     return x * sigma_pitch / math.sqrt(var_mean)
 
@@ -86,23 +88,25 @@ def synthetic_run(seed: int, value_rate: float = 0.0, zero_rate: float = 0.0, va
     return t, {"value": value, "zero": zero}, OMEGA * t
 
 
-def first_verdict(t, series, angle, zero_within: float, checks: int, truncation_search: float):
+def first_verdict(t, series, angle, zero_within: float, checks: int, truncation_search: float, *, t_hold: float = T_HOLD,
+                  pitch: float = PITCH, omega: float = OMEGA, radius: float = RADIUS, average_time: float = AVERAGE_TIME,
+                  floors: dict = FLOORS, dt: float = DT, period_pitches: int = 1):
     """Ask the detector as the testbed does, ``checks`` steady verdicts in a row ending the run; the verdict
-    that ended it (or the last one at the drive's end)."""
-    start = T_HOLD + PITCH / OMEGA
-    check = start + AVERAGE_TIME
-    speed = np.full(t.size, (1.0 - 0.3) * RADIUS * OMEGA)
+    that ended it (or the last one at the drive's end). The keywords describe the run (defaults: the smoke run's)."""
+    start = t_hold + pitch / omega
+    check = start + average_time
+    speed = np.full(t.size, (1.0 - 0.3) * radius * omega)
     state, in_a_row = None, 0
     for k in range(t.size):
         if t[k] < check - 1e-12:
             continue
-        check = t[k] + PITCH / OMEGA
+        check = t[k] + pitch / omega
         n = k + 1
         state = detect_steady_state(
             t[:n], {q: y[:n] for q, y in series.items()}, tread_angle=angle[:n], travel_speed=speed[:n],
-            radius=RADIUS, pitch=PITCH, start=start, min_pitches=int(math.ceil(AVERAGE_TIME * OMEGA / PITCH)),
-            tolerance=TOLERANCE, floors=FLOORS, slip_target=None, slip_tolerance=0.03, sample_interval=DT,
-            zero_within=zero_within, truncation_search=truncation_search)
+            radius=radius, pitch=pitch, start=start, min_pitches=int(math.ceil(average_time * omega / pitch)),
+            tolerance=TOLERANCE, floors=floors, slip_target=None, slip_tolerance=0.03, sample_interval=dt,
+            zero_within=zero_within, truncation_search=truncation_search, period_pitches=period_pitches)
         state, in_a_row = confirm_steady(state, in_a_row, checks)
         if state.steady:
             break

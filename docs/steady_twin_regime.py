@@ -26,28 +26,14 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from wheelsoil.coupling.steady import confirm_steady, detect_steady_state
+from steady_campaign import first_verdict, red_noise
 
 ROOT = Path(__file__).resolve().parent
 DT, OMEGA, PITCH, PERIOD = 0.005, 1.724, math.radians(22.5), 8
 T_HOLD, AVERAGE_TIME, LOAD, RADIUS = 0.2, 1.0, 21.65, 0.058
-TOLERANCE, CORRELATION = 0.1, 0.05
+CORRELATION = 0.05  # AR(1) correlation time [s]; the tolerance is steady_campaign.TOLERANCE (10 %)
 QUANTITIES = {"drawbar_pull": (9.0, 2.5, 1.0), "lateral_force": (-6.0, 0.8, 0.4)}  # mean, pitch scatter, grouser [N]
 FLOORS = {q: 0.05 * LOAD for q in QUANTITIES}
-
-
-def red_noise(rng, n: int, sigma_pitch: float) -> np.ndarray:
-    """AR(1) noise (correlation time CORRELATION) whose means over one pitch scatter by ``sigma_pitch``."""
-    phi = math.exp(-DT / CORRELATION)
-    e = rng.normal(0.0, math.sqrt(1.0 - phi * phi), n)
-    x = np.empty(n)
-    x[0] = rng.normal()
-    for k in range(1, n):
-        x[k] = phi * x[k - 1] + e[k]
-    m = PITCH / OMEGA / DT
-    var_mean = ((1.0 + phi) / (1.0 - phi) - 2.0 * phi * (1.0 - phi ** m) / (m * (1.0 - phi) ** 2)) / m
-    return x * sigma_pitch / math.sqrt(var_mean)
 
 
 def synthetic_run(seed: int, drift: float, drive: float):
@@ -59,32 +45,18 @@ def synthetic_run(seed: int, drift: float, drive: float):
     series = {}
     for q, (mean, sigma, grouser) in QUANTITIES.items():
         phase = rng.uniform(0.0, 2.0 * np.pi)
-        series[q] = mean + grouser * np.sin(OMEGA * t / PITCH * 2 * np.pi + phase) + red_noise(rng, t.size, sigma)
+        series[q] = (mean + grouser * np.sin(OMEGA * t / PITCH * 2 * np.pi + phase)
+                     + red_noise(rng, t.size, sigma, dt=DT, pitch_time=PITCH / OMEGA, correlation=CORRELATION))
     series["drawbar_pull"] += drift * QUANTITIES["drawbar_pull"][0] * after
     return t, series, OMEGA * t
 
 
-def verdict(t, series, angle) -> tuple[bool, float]:
-    """(steady, drift estimate over the window) as the testbed's two-in-a-row rule ends the run."""
-    start = T_HOLD + PITCH / OMEGA
-    check = start + AVERAGE_TIME
-    speed = np.full(t.size, 0.5 * RADIUS * OMEGA)
-    state, in_a_row = None, 0
-    for k in range(t.size):
-        if t[k] < check - 1e-12:
-            continue
-        check = t[k] + PITCH / OMEGA
-        n = k + 1
-        state = detect_steady_state(
-            t[:n], {q: y[:n] for q, y in series.items()}, tread_angle=angle[:n], travel_speed=speed[:n],
-            radius=RADIUS, pitch=PITCH, start=start, min_pitches=int(math.ceil(AVERAGE_TIME * OMEGA / PITCH)),
-            tolerance=TOLERANCE, floors=FLOORS, slip_target=None, slip_tolerance=0.03, sample_interval=DT,
-            period_pitches=PERIOD)
-        state, in_a_row = confirm_steady(state, in_a_row, 2)
-        if state.steady:
-            break
-    drift = state.stats.get("drawbar_pull", {}).get("drift", math.nan) if state is not None else math.nan
-    return bool(state is not None and state.steady), drift
+def verdict(t, series, angle) -> bool:
+    """Whether the testbed's two-in-a-row rule ends the run steady (:func:`steady_campaign.first_verdict` in the twin's
+    regime)."""
+    state = first_verdict(t, series, angle, 2.0, 2, 0.5, t_hold=T_HOLD, pitch=PITCH, omega=OMEGA, radius=RADIUS,
+                          average_time=AVERAGE_TIME, floors=FLOORS, dt=DT, period_pitches=PERIOD)
+    return bool(state is not None and state.steady)
 
 
 def main() -> None:
@@ -96,8 +68,7 @@ def main() -> None:
     rows = []
     for drive in (6.0, 20.0):
         for drift in (0.0, 0.02, 0.05, 0.1):
-            calls = [verdict(*synthetic_run(20_000 + s, drift, drive)) for s in range(args.seeds)]
-            steady = np.array([c[0] for c in calls])
+            steady = np.array([verdict(*synthetic_run(20_000 + s, drift, drive)) for s in range(args.seeds)])
             rows.append((drive, drift, float(steady.mean())))
             print(rows[-1], flush=True)
     lines = ["# How often the detector calls a CMU-twin run steady", "",
