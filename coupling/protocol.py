@@ -108,8 +108,9 @@ class WindUp(ProtocolStep):
         return min(max(spin, 0.5 * omega), 1.5 * omega), bench.travel_speed
 
     def after_sample(self, bench, state, row, t):
-        if wound_up(bench, state) or t >= state.t_windup + 0.5 * bench.spec.drive_time:
-            state.windup_converged = wound_up(bench, state)
+        converged = wound_up(bench, state)
+        if converged or t >= state.t_windup + 0.5 * bench.spec.drive_time:
+            state.windup_converged = converged
             return NEXT
         return STAY
 
