@@ -27,6 +27,7 @@ from wheelsoil.errors import WheelsoilInputError
 
 from .extensions import BASELINE_FREE, Parameter
 from .measured import Measurements
+from .sinkage_solve import SinkageWarmStart
 from .terramechanics import RigidWheel, SoilParameters, predict
 
 RESPONSES = ("drawbar_pull", "lateral_force", "sinkage", "torque")
@@ -36,15 +37,28 @@ UNIDENTIFIED_RANGE_FRACTION = 0.25
 BINDING_CHI2 = 4.0
 
 
-def model_responses(soil: SoilParameters, data: Measurements) -> dict[str, np.ndarray]:
-    """The model's drawbar pull, lateral force, sinkage and torque at every measured condition."""
+@dataclass
+class WarmStarts:
+    """The sinkage solves' warm starts over one set of measurements, one per wheel in it (a fit's successive
+    evaluations start each wheel's solve from its last roots; :mod:`~wheelsoil.validation.sinkage_solve`)."""
+
+    by_wheel: dict[tuple, SinkageWarmStart] = field(default_factory=dict)
+
+    def for_wheel(self, key) -> SinkageWarmStart:
+        return self.by_wheel.setdefault(tuple(float(v) for v in key), SinkageWarmStart())
+
+
+def model_responses(soil: SoilParameters, data: Measurements, warm: WarmStarts | None = None) -> dict[str, np.ndarray]:
+    """The model's drawbar pull, lateral force, sinkage and torque at every measured condition (``warm``: start
+    the sinkage solves from the roots of the last call given the same object and data)."""
     out = {q: np.full(len(data), np.nan) for q in RESPONSES}
     wheels = np.stack([data.radius, data.width, data.grouser_height, data.grouser_count], axis=1)
     for key in np.unique(wheels, axis=0):
         rows = np.all(wheels == key, axis=1)
         wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
         pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
-                       gravity=data.gravity[rows], passes=data.passes[rows], travel_slip=data.travel_slip[rows])
+                       gravity=data.gravity[rows], passes=data.passes[rows], travel_slip=data.travel_slip[rows],
+                       warm_start=None if warm is None else warm.for_wheel(key))
         for q in RESPONSES:
             out[q][rows] = pred[q]
     return out
@@ -62,10 +76,10 @@ def response_scales(data: Measurements, responses) -> dict[str, float]:
     return scales
 
 
-def normalised_residuals(soil, data, responses, scales, *, split: bool = False):
+def normalised_residuals(soil, data, responses, scales, *, split: bool = False, warm: WarmStarts | None = None):
     """(model - measured) / scale over the measured values of each response, concatenated (or a dict by
-    response with ``split``)."""
-    pred = model_responses(soil, data)
+    response with ``split``); ``warm`` as :func:`model_responses`."""
+    pred = model_responses(soil, data, warm)
     parts = {}
     for q in responses:
         y = data.responses[q]
@@ -191,9 +205,11 @@ def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, 
             values["shear_modulus_y"] = values["shear_modulus_x"]
         return replace(start, **values)
 
+    warm = WarmStarts()  # each evaluation starts its sinkage solves from the last one's roots
+
     def residual(x):
         try:
-            return normalised_residuals(soil_of(x), data, responses, scales)
+            return normalised_residuals(soil_of(x), data, responses, scales, warm=warm)
         except WheelsoilInputError:  # a combination outside the model's domain (e.g. a1 + a2 > 1)
             return np.full(n_res, 1e3)
 

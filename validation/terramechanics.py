@@ -60,6 +60,7 @@ from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
 from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
+from .sinkage_solve import SinkageWarmStart, solve_sinkage
 
 __all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
            "side_bulldozing_force", "bulldozing_force", "grouser_forces", "janosi_hanamoto", "resultant_shear", "QUADRATURE_POINTS",
@@ -445,7 +446,7 @@ def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gr
 
 def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.0, load, gravity=EARTH_GRAVITY,
             passes=1.0, travel_slip=None, max_sinkage_ratio: float = 0.95, tolerance: float = 1e-10,
-            max_iterations: int = 200) -> dict:
+            max_iterations: int = 200, warm_start: SinkageWarmStart | None = None) -> dict:
     """Steady-state forces and sinkage for each condition (arrays broadcast together).
 
     The wheel's motion: ``slip`` along the heading (architecture), ``travel_slip`` against the whole travel speed
@@ -454,44 +455,23 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
     ``travel_slip`` falls back on ``slip`` row by row.
 
     Solves F_z(z) = W for the sinkage z in (0, max_sinkage_ratio r) (F_z rises with z) by the Illinois
-    variant of false position, vectorised over conditions, to |F_z - W| <= tolerance W; then evaluates
-    :func:`contact_forces`. Returns arrays shaped like the broadcast inputs: sinkage [m], drawbar_pull,
-    lateral_force, vertical_force [N], torque [N m], theta_f, theta_m, theta_r [rad], and ``supported``
-    (False where even z = max_sinkage_ratio r cannot carry W; those rows hold that sinkage).
+    variant of false position, vectorised over conditions, to |F_z - W| <= tolerance W
+    (:func:`~wheelsoil.validation.sinkage_solve.solve_sinkage`; with ``warm_start``, from the roots of the last
+    call that passed the same object, as a fit's successive calls do); then evaluates :func:`contact_forces`.
+    Returns arrays shaped like the broadcast inputs: sinkage [m], drawbar_pull, lateral_force, vertical_force [N],
+    torque [N m], theta_f, theta_m, theta_r [rad], and ``supported`` (False where even z = max_sinkage_ratio r
+    cannot carry W; those rows hold that sinkage).
     """
     shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
     beta_deg = np.degrees(beta)
 
-    def excess(z):
-        return contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, vertical_only=True,
-                              travel_slip=s_travel, load=load)["vertical_force"] - load
+    def excess(z, rows):
+        return contact_forces(soil, wheel, z, i[rows], beta_deg[rows], g[rows], passes=n_p[rows], vertical_only=True,
+                              travel_slip=s_travel[rows], load=load[rows])["vertical_force"] - load[rows]
 
-    lo, f_lo = np.zeros_like(load), -load.copy()
-    hi = np.full_like(load, max_sinkage_ratio * wheel.radius)
-    f_hi = excess(hi)
-    supported = f_hi >= 0.0
-    z = hi.copy()
-    side = np.zeros(load.shape, int)  # which end the last step kept (-1 lo, +1 hi) for the Illinois rule
-    active = supported & (np.abs(f_hi) > tolerance * load)
-    for _ in range(max_iterations):
-        if not active.any():
-            break
-        cand = np.where(active, hi - f_hi * (hi - lo) / np.where(f_hi != f_lo, f_hi - f_lo, 1.0), z)
-        cand = np.where((cand > lo) & (cand < hi), cand, 0.5 * (lo + hi))  # guard against round-off
-        f = excess(cand)
-        z = np.where(active, cand, z)
-        below = active & (f < 0.0)  # root above cand: cand becomes the new lo
-        above = active & (f >= 0.0)
-        # Illinois: when the same end survives twice, halve its function value
-        f_hi = np.where(below & (side == -1), 0.5 * f_hi, f_hi)
-        f_lo = np.where(above & (side == 1), 0.5 * f_lo, f_lo)
-        lo, f_lo = np.where(below, cand, lo), np.where(below, f, f_lo)
-        hi, f_hi = np.where(above, cand, hi), np.where(above, f, f_hi)
-        side = np.where(below, -1, np.where(above, 1, side))
-        active &= np.abs(f) > tolerance * load
-    else:
-        raise RuntimeError(f"sinkage did not converge in {max_iterations} iterations")
-    z = np.where(supported, z, max_sinkage_ratio * wheel.radius)
+    solution = solve_sinkage(excess, load, max_sinkage_ratio * wheel.radius, tolerance=tolerance,
+                             max_iterations=max_iterations, warm=warm_start)
+    z, supported = solution.sinkage, solution.supported
     out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel, load=load)
     out["sinkage"] = z
     out["supported"] = supported
