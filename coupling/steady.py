@@ -246,11 +246,19 @@ def _pitch_means(t, angle, v, series: dict, bounds) -> tuple:
     return durations, turned, speeds, batches
 
 
-def _quantity_reasons(name: str, st: dict, tolerance: float, floors: dict, zero_within: float) -> list[str]:
+def _margin(confidence: float, sem: float) -> float:
+    """``confidence`` standard errors ``sem`` (none at all when ``confidence`` is 0, even where sem is infinite)."""
+    return confidence * sem if confidence else 0.0
+
+
+def _quantity_reasons(name: str, st: dict, tolerance: float, floors: dict, zero_within: float,
+                      drift_confidence: float = 0.0) -> list[str]:
     """Why quantity ``name``'s window statistics ``st`` are not steady (empty: steady); sets its
     ``zero_within_noise``. A quantity zero within its noise has no value to hold: it is steady when it does not
     trend beyond its noise; any other must drift, and change between the window's halves, by less than the
-    tolerance times the larger of its mean and its floor."""
+    tolerance times the larger of its mean and its floor, with ``drift_confidence`` standard errors of each
+    added to it (0: the estimate alone must lie within the tolerance; 1: the estimate plus one standard error,
+    so a window too short to tell its drift from the tolerance is not called steady)."""
     allowed = tolerance * max(abs(st["mean"]), floors.get(name, 0.0))
     st["zero_within_noise"] = bool(abs(st["mean"]) < zero_within * st["sem"])
     if st["zero_within_noise"]:
@@ -258,12 +266,15 @@ def _quantity_reasons(name: str, st: dict, tolerance: float, floors: dict, zero_
             return [f"{name} is zero within its noise ({st['mean']:+.3g} +- {st['sem']:.2g}) but trends: "
                     f"drift {st['drift']:+.4g} +- {st['drift_sem']:.2g}, change between the window's halves "
                     f"{st['step']:+.4g} +- {st['step_sem']:.2g} (allowed: {zero_within:g} standard errors)"]
-    elif abs(st["drift"]) > allowed:
+    elif abs(st["drift"]) + _margin(drift_confidence, st["drift_sem"]) > allowed:
+        margin = f" plus {drift_confidence:g} standard errors" if drift_confidence else ""
         return [f"{name} drifts by {st['drift']:+.4g} +- {st['drift_sem']:.2g} over the window (allowed "
-                f"+-{allowed:.3g})" + ("; within its own noise: a longer window would tell"
-                                       if abs(st["drift"]) < 2.0 * st["drift_sem"] else "")]
-    elif abs(st["step"]) > allowed:
-        return [f"{name} changes by {st['step']:+.4g} between the window's halves (allowed +-{allowed:.3g})"]
+                f"+-{allowed:.3g}{margin})" + ("; within its own noise: a longer window would tell"
+                                               if abs(st["drift"]) < 2.0 * st["drift_sem"] else "")]
+    elif abs(st["step"]) + _margin(drift_confidence, st["step_sem"]) > allowed:
+        margin = f" plus {drift_confidence:g} standard errors" if drift_confidence else ""
+        return [f"{name} changes by {st['step']:+.4g} +- {st['step_sem']:.2g} between the window's halves (allowed "
+                f"+-{allowed:.3g}{margin})"]
     return []
 
 
@@ -297,6 +308,7 @@ def detect_steady_state(
     period_pitches: int = 1,
     zero_within: float = ZERO_WITHIN,
     truncation_search: float = 0.5,
+    drift_confidence: float = 0.0,
 ) -> SteadyState:
     """The steady window ending at the last sample, its start chosen by MSER (see the module docstring).
 
@@ -311,7 +323,9 @@ def detect_steady_state(
     floors: name -> floor of the relative tolerance; zero_within: standard errors within which a quantity
     counts as zero within its noise (0: every quantity must hold the tolerance); truncation_search: the
     fraction of the pitches since ``start`` over which MSER looks for the transient's end (0.5: the first half,
-    MSER's own rule; 1.0: up to the shortest window, the search wheelsoil made before); slip_target: commanded slip
+    MSER's own rule; 1.0: up to the shortest window, the search wheelsoil made before); drift_confidence: standard
+    errors of a quantity's drift (and of its halves' change) added to the estimate before it is held to the
+    tolerance (0: the estimate alone, the default; :func:`_quantity_reasons`); slip_target: commanded slip
     (``None``: the tread-slip criterion is skipped, e.g. to test the statistics alone).
     """
     t = np.asarray(t, float)
@@ -354,7 +368,8 @@ def detect_steady_state(
     dof = pitch_noise_dof(n_pitches, period_pitches)
     stats = {name: window_stats(np.asarray(y, float), b, noise=noise[name], period=period_pitches, noise_dof=dof)
              for name, y in series.items()}
-    reasons = [r for name, st in stats.items() for r in _quantity_reasons(name, st, tolerance, floors, zero_within)]
+    reasons = [r for name, st in stats.items()
+               for r in _quantity_reasons(name, st, tolerance, floors, zero_within, drift_confidence)]
     w = slice(n_pitches - m, n_pitches)
     spin = turned[w].sum() / durations[w].sum()
     slip = longitudinal_slip(float(speeds[w] @ durations[w] / durations[w].sum()), spin, radius)

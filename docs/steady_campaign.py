@@ -90,7 +90,7 @@ def synthetic_run(seed: int, value_rate: float = 0.0, zero_rate: float = 0.0, va
 
 def first_verdict(t, series, angle, zero_within: float, checks: int, truncation_search: float, *, t_hold: float = T_HOLD,
                   pitch: float = PITCH, omega: float = OMEGA, radius: float = RADIUS, average_time: float = AVERAGE_TIME,
-                  floors: dict = FLOORS, dt: float = DT, period_pitches: int = 1):
+                  floors: dict = FLOORS, dt: float = DT, period_pitches: int = 1, drift_confidence: float = 0.0):
     """Ask the detector as the testbed does, ``checks`` steady verdicts in a row ending the run; the verdict
     that ended it (or the last one at the drive's end). The keywords describe the run (defaults: the smoke run's)."""
     start = t_hold + pitch / omega
@@ -106,7 +106,8 @@ def first_verdict(t, series, angle, zero_within: float, checks: int, truncation_
             t[:n], {q: y[:n] for q, y in series.items()}, tread_angle=angle[:n], travel_speed=speed[:n],
             radius=radius, pitch=pitch, start=start, min_pitches=int(math.ceil(average_time * omega / pitch)),
             tolerance=TOLERANCE, floors=floors, slip_target=None, slip_tolerance=0.03, sample_interval=dt,
-            zero_within=zero_within, truncation_search=truncation_search, period_pitches=period_pitches)
+            zero_within=zero_within, truncation_search=truncation_search, period_pitches=period_pitches,
+            drift_confidence=drift_confidence)
         state, in_a_row = confirm_steady(state, in_a_row, checks)
         if state.steady:
             break

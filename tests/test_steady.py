@@ -152,6 +152,31 @@ def test_a_drift_within_its_noise_beyond_the_tolerance_is_refused_and_says_so(se
         assert reasons == []
 
 
+@pytest.mark.parametrize("seed", [21, 22, 23])
+def test_drift_confidence_holds_the_drift_plus_its_standard_errors_to_the_tolerance(seed):
+    """With drift_confidence k the drift estimate plus k of its standard errors (and likewise the change between
+    the halves) must lie within the tolerance: the noisy flat force of the test above is refused exactly when
+    |drift| + k drift_sem or |step| + k step_sem exceeds 10 % of max(|mean|, floor), with the margin named; k = 0
+    is the default detector, verdict for verdict."""
+    t, series, angle, speed = synthetic_run(seed, t_end=3.0, tau=0.01)
+    rng = np.random.default_rng(seed)
+    pitch_of = np.floor(angle / PITCH).astype(int)
+    series["drawbar_pull"] = series["drawbar_pull"] + rng.normal(0.0, 60.0, pitch_of.max() + 1)[pitch_of]
+    default = detect(t, series, angle, speed)
+    assert detect(t, series, angle, speed, drift_confidence=0.0).steady == default.steady
+    for k in (0.5, 1.0, 3.0):
+        state = detect(t, series, angle, speed, drift_confidence=k)
+        st = state.stats["drawbar_pull"]
+        allowed = 0.1 * max(abs(st["mean"]), 150.0)
+        refused = (abs(st["drift"]) + k * st["drift_sem"] > allowed or abs(st["step"]) + k * st["step_sem"] > allowed)
+        named = [r for r in state.reasons if r.startswith("drawbar_pull") and f"plus {k:g} standard errors" in r]
+        assert bool(named) == refused
+        if refused:
+            assert not state.steady
+    # a large enough margin refuses every window of this noise
+    assert not detect(t, series, angle, speed, drift_confidence=10.0).steady
+
+
 def test_pitch_noise_recovers_the_scatter_of_pitch_means_and_sees_a_trend_only_through_its_step():
     """Mean square successive difference (von Neumann 1941): over 400 draws of 12 independent pitch means with
     sigma = 5, the mean of sigma_hat^2 is sigma^2 within 10 %; on a line rising by one sigma per pitch it is
