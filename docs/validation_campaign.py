@@ -8,6 +8,7 @@ Usage (from the repository root; 15-60 s a draw on one core, ``--workers`` proce
     python docs/validation_campaign.py pair   --draws 30 --seed 3 --workers 2   # two mechanisms hidden together
     python docs/validation_campaign.py ooc    --draws 30 --seed 4 --workers 2   # effects outside the catalogue
     python docs/validation_campaign.py ooc-load --draws 40 --seed 41 --workers 2 --resume  # load and gravity varied
+    python docs/validation_campaign.py single --draws 44 --seed 82 --design whole-domain  # braking, dragged, 90 deg
     python docs/validation_campaign.py periodic --draws 40 --seed 7             # periodic mechanisms in series
     python docs/validation_campaign.py summary docs/validation/campaigns/*.jsonl  # the table of rates
 
@@ -39,8 +40,24 @@ import numpy as np
 KINDS = ("null", "single", "pair", "ooc", "ooc-load")
 
 
-def draw(kind: str, index: int, seed_seq) -> dict:
-    """One synthetic dataset of ``kind`` and the workflow's verdict on it."""
+#: The synthetic designs a campaign can draw its conditions from (``--design``): ``factorial``, the generators' rig
+#: (:func:`wheelsoil.validation.synthetic.conditions`: driving slips, 0-30 deg; ``ooc-load`` always uses its own
+#: load-and-gravity design); ``whole-domain``, the rig's whole domain (braking, dragged and 90 deg rows too:
+#: :func:`wheelsoil.validation.synthetic.whole_domain_conditions`, issue 36 item 6).
+DESIGNS = ("factorial", "whole-domain")
+
+
+def design_conditions(kind: str, design: str):
+    """The conditions of a ``kind`` campaign in ``design`` (None: the generators' default factorial)."""
+    from wheelsoil.validation import synthetic as syn
+
+    if kind == "ooc-load":
+        return syn.load_gravity_conditions()
+    return syn.whole_domain_conditions() if design == "whole-domain" else None
+
+
+def draw(kind: str, index: int, seed_seq, design: str = "factorial") -> dict:
+    """One synthetic dataset of ``kind`` in ``design`` (:data:`DESIGNS`) and the workflow's verdict on it."""
     from wheelsoil.validation import synthetic as syn
     from wheelsoil.validation.discovery import discover
 
@@ -56,12 +73,12 @@ def draw(kind: str, index: int, seed_seq) -> dict:
     if kind in ("ooc", "ooc-load"):
         effect = syn.draw_out_of_catalogue(rng, [list(syn.OUT_OF_CATALOGUE)[index % len(syn.OUT_OF_CATALOGUE)]])
     noise, relative = float(rng.uniform(0.01, 0.05)), float(rng.uniform(0.0, 0.04))
-    cond = syn.load_gravity_conditions() if kind == "ooc-load" else None
+    cond = design_conditions(kind, design)
     data = syn.synthetic_measurements(hidden, rng, effect=effect, noise=noise, relative_noise=relative, cond=cond)
     t0 = time.perf_counter()
     d = discover(data, seed=int(rng.integers(2 ** 31)))
     found = d.found
-    return {"kind": kind, "index": index, "truth": truth, "hidden": hidden, "effect": effect, "noise": noise,
+    return {"kind": kind, "design": design, "index": index, "truth": truth, "hidden": hidden, "effect": effect, "noise": noise,
             "relative_noise": relative, "found": found, "partial": [c.extension.name for c in d.partial],
             "ambiguities": d.ambiguities,
             "unexplained": [u["text"] for u in d.unexplained], "wrong": sorted(set(found) - set(truth)),
@@ -78,10 +95,15 @@ def _run(args) -> int:
     seqs = np.random.SeedSequence(args.seed).spawn(args.draws)
     done = set()
     if args.resume and out.is_file():
-        done = {json.loads(line)["index"] for line in out.read_text().splitlines() if line.strip()}
+        kept = [json.loads(line) for line in out.read_text().splitlines() if line.strip()]
+        other = {r.get("design", "factorial") for r in kept} - {args.design}
+        if other:
+            raise SystemExit(f"{out} holds draws of design {sorted(other)}, not --design {args.design}: resume it with "
+                             f"that design, or write to another --out")
+        done = {r["index"] for r in kept}
         print(f"{out}: {len(done)} draw(s) done before, kept", flush=True)
     with open(out, "a" if args.resume else "w") as fh, ProcessPoolExecutor(args.workers) as pool:
-        futures = [pool.submit(draw, args.kind, k, s) for k, s in enumerate(seqs) if k not in done]
+        futures = [pool.submit(draw, args.kind, k, s, args.design) for k, s in enumerate(seqs) if k not in done]
         for f in futures:
             r = f.result()
             fh.write(json.dumps(r) + "\n")
@@ -113,7 +135,9 @@ def summarise(paths) -> str:
         unexpl = sum(1 for r in recs if r["unexplained"])
         partial = (pct(sum(1 for r in recs if r["partial"])) if all("partial" in r for r in recs)
                    else "not recorded")
-        rows.append(f"| `{Path(path).name}` | {n} | {pct(named) if kind in ('single', 'pair') else '–'} | {pct(wrong)} | "
+        design = recs[0].get("design", "factorial")
+        label = f"`{Path(path).name}`" + ("" if design == "factorial" else f" ({design})")
+        rows.append(f"| {label} | {n} | {pct(named) if kind in ('single', 'pair') else '–'} | {pct(wrong)} | "
                     f"{partial} | {pct(amb)} | {pct(unexpl)} | {goals.get(kind, '')} |")
         if kind in ("single", "ooc", "ooc-load"):
             key = (lambda r: r["truth"][0]) if kind == "single" else (lambda r: r["effect"][0])
@@ -149,6 +173,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--out", default=None)
     ap.add_argument("--resume", action="store_true", help="keep the draws the output file holds; run the rest")
+    ap.add_argument("--design", choices=DESIGNS, default="factorial",
+                    help="the synthetic conditions: the generators' factorial (default) or the rig's whole domain "
+                         "(braking, dragged and 90 deg rows too)")
     ap.add_argument("--noise", type=float, default=0.03,
                     help="periodic: red-noise standard deviation / median steady drawbar pull (default 0.03)")
     args = ap.parse_args(argv)

@@ -189,3 +189,28 @@ def test_travel_and_heading_slips_give_one_prediction():
     by_heading = predict(SAND, WHEEL, slip=heading_slip_from_travel(travel, beta), slip_angle=beta, load=150.0)
     for q in QUANTITIES:
         np.testing.assert_allclose(by_travel[q], by_heading[q], rtol=1e-7, atol=1e-9)
+
+
+def test_the_whole_domain_synthetic_design_holds_braking_dragged_and_sideways_rows():
+    """The campaigns' whole-domain design (issue 36 item 6): every kind of motion the rig sets, each at every load and
+    gravity, its heading slip the one its travel slip gives, and measurements drawn on it kept as such."""
+    from wheelsoil.validation.synthetic import SIDEWAYS_SLIPS, WHOLE_DOMAIN_SLIPS, synthetic_measurements, \
+        whole_domain_conditions
+    cond = whole_domain_conditions()
+    n = 4 * len(WHOLE_DOMAIN_SLIPS) * 2 * 3 + len(SIDEWAYS_SLIPS) * 2 * 3
+    assert all(np.shape(v) == (n,) for v in cond.values())
+    np.testing.assert_allclose(cond["slip"], heading_slip_from_travel(cond["travel_slip"], cond["slip_angle"]))
+    data = synthetic_measurements({}, np.random.default_rng(0), cond=cond)
+    kinds = data.kinds()
+    sideways = data.slip_angle == 90.0
+    assert sideways.sum() == len(SIDEWAYS_SLIPS) * 2 * 3
+    for kind in ("driving", "braking", "dragged"):
+        for at_90 in (False, True):
+            rows = (kinds == kind) & (sideways == at_90)
+            if kind == "braking" and at_90:
+                assert not rows.any()  # at 90 deg the design has a dragged wheel and turning ones only
+                continue
+            assert rows.any()
+            assert set(data.load[rows]) == {60.0, 120.0} and len(set(data.gravity[rows])) == 3
+    np.testing.assert_array_equal(data.travel_slip, cond["travel_slip"])
+    assert all(np.isfinite(y).all() for y in data.responses.values())

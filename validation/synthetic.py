@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from wheelsoil.gravity import EARTH_GRAVITY
+from wheelsoil.slip import heading_slip_from_travel
 
 from .extensions import BASELINE_OFF
 from .measured import Measurements
@@ -113,6 +114,29 @@ def load_gravity_conditions():
     return conditions(loads=(40.0, 80.0, 160.0), gravities=(EARTH_GRAVITY, 1.62))
 
 
+#: Travel slips of the whole-domain design below 90 deg: dragged (-1), braking (-0.5, -0.2) and driving, as the CMU rig
+#: sets them.
+WHOLE_DOMAIN_SLIPS = (-1.0, -0.5, -0.2, 0.05, 0.2, 0.35, 0.5, 0.7)
+#: Travel slips of its rows at 90 deg: a wheel dragged sideways without turning (-1), and turning ones.
+SIDEWAYS_SLIPS = (-1.0, 0.2, 0.5)
+
+
+def whole_domain_conditions(slips=WHOLE_DOMAIN_SLIPS, slip_angles=(0.0, 10.0, 20.0, 30.0),
+                            sideways_slips=SIDEWAYS_SLIPS, loads=(60.0, 120.0),
+                            gravities=(EARTH_GRAVITY, 3.71, 1.62), passes=(1, 2, 3)):
+    """The rig's whole domain (issue 36): :func:`conditions` with the slip given as the CMU rig gives it, against the
+    whole travel speed, braking as well as driving, plus rows at 90 deg where the wheel ploughs sideways (dragged
+    without turning, and turning), each at every load and gravity. 8 x 4 x 2 x 3 + 3 x 2 x 3 = 210 conditions
+    by default. Returns :func:`conditions`' keys plus ``travel_slip``; ``slip`` is the heading slip it gives
+    (+-1 at 90 deg, where the heading slip cannot say how fast the wheel slides: the model reads the travel slip)."""
+    below = conditions(slips=slips, slip_angles=slip_angles, loads=loads, gravities=gravities, passes=passes)
+    side = conditions(slips=sideways_slips, slip_angles=(90.0,), loads=loads, gravities=gravities, passes=passes)
+    out = {k: np.concatenate([below[k], side[k]]) for k in below}
+    out["travel_slip"] = out.pop("slip")
+    out["slip"] = heading_slip_from_travel(out["travel_slip"], out["slip_angle"])
+    return out
+
+
 def conditions(slips=(0.05, 0.2, 0.35, 0.5, 0.7), slip_angles=(0.0, 10.0, 20.0, 30.0),
                loads=(60.0, 120.0), gravities=(EARTH_GRAVITY, 3.71, 1.62), passes=(1, 2, 3)):
     """The full factorial of test conditions (slip, slip angle [deg], load [N], gravity [m/s^2]: Earth, Mars and
@@ -191,6 +215,7 @@ def synthetic_measurements(hidden: dict, rng: np.random.Generator, *, soil: Soil
         grouser_count=full(wheel.grouser_count), group=np.full(n, "synthetic"), responses=responses,
         notes=f"hidden: {hidden or 'nothing'}{f'; out of catalogue: {effect[0]} {effect[1]:.3g}' if effect else ''}",
         passes=np.asarray(cond.get("passes", np.ones(n)), float),
+        travel_slip=np.asarray(cond["travel_slip"], float) if "travel_slip" in cond else None,
     )
 
 
