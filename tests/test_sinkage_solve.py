@@ -95,3 +95,15 @@ def test_predict_warm_and_cold_agree_on_the_wheel_model():
     np.testing.assert_allclose(hot["vertical_force"], 20.0, rtol=1e-9)
     for q in ("sinkage", "drawbar_pull", "lateral_force", "torque"):
         np.testing.assert_allclose(hot[q], cold[q], rtol=1e-7, atol=1e-9 * np.abs(cold[q]).max())
+
+
+def test_a_condition_the_model_cannot_evaluate_ends_unsupported_not_in_an_endless_loop():
+    """F_z NaN (a soil outside the model's domain) for one condition: it is reported unsupported at z_max, as the
+    solve before the warm start did, and the others are solved."""
+    k, n, load = np.array([1e5, np.nan, 2e5]), np.array([1.0, 1.0, 1.2]), np.array([50.0, 50.0, 80.0])
+    excess, root = power_law(k, n, load)
+    for warm in (None, SinkageWarmStart(sinkage=np.full(3, 0.01), stiffness=np.full(3, 1e4))):
+        sol = solve_sinkage(excess, load, Z_MAX, tolerance=TOLERANCE, warm=warm)
+        np.testing.assert_array_equal(sol.supported, [True, False, True])
+        assert sol.sinkage[1] == Z_MAX
+        np.testing.assert_allclose(sol.sinkage[[0, 2]], root[[0, 2]], rtol=1e-9)

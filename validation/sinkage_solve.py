@@ -75,7 +75,7 @@ def solve_sinkage(excess: Callable[[np.ndarray, np.ndarray], np.ndarray], load: 
         below = value < 0.0  # the root lies above: the point becomes the bracket's low end
         lo[rows[below]], f_lo[rows[below]] = at[below], value[below]
         hi[rows[~below]], f_hi[rows[~below]] = at[~below], value[~below]
-        done[rows] = np.abs(value) <= limit[rows]
+        done[rows] = ~(np.abs(value) > limit[rows])  # NaN (a soil the model cannot evaluate) ends the row too
         return below
 
     if warm is not None and warm.usable_for(count):
@@ -101,7 +101,8 @@ def solve_sinkage(excess: Callable[[np.ndarray, np.ndarray], np.ndarray], load: 
     unknown = np.flatnonzero(~done & np.isnan(f_hi))
     if unknown.size:
         evaluate(unknown, hi[unknown])
-    supported = done | np.isfinite(f_hi)  # a point at or above the root was found, else F_z(z_max) < W
+    # a point at or above the root was found, else F_z(z_max) < W (or F_z is NaN: that row keeps z_max)
+    supported = (done & np.isfinite(f)) | np.isfinite(f_hi)
     active = ~done & supported
     for _ in range(max_iterations):
         rows = np.flatnonzero(active)
