@@ -13,6 +13,7 @@ import numpy as np
 import taichi as ti
 
 from . import integrator
+from .sphere_state import SphereMotion
 
 
 @dataclass(frozen=True)
@@ -95,9 +96,9 @@ class ParticleArrays:
         integrator.contact_view(p.x, p.v, p.w, p.r, p.m, p.I, p.x_r, p.v_m, p.w_i)
         return p
 
-    def download(self) -> dict:
-        """x, v, w, f, t as NumPy arrays (the state the host mirror keeps)."""
-        return {k: getattr(self, k).to_numpy() for k in ("x", "v", "w", "f", "t")}
+    def download(self) -> SphereMotion:
+        """x, v, w, f, t as NumPy arrays (the motion the host state keeps: :class:`~.sphere_state.SphereState`)."""
+        return SphereMotion(*(getattr(self, k).to_numpy() for k in ("x", "v", "w", "f", "t")))
 
     def device_state(self) -> DeviceState:
         return DeviceState(self.x, self.v, self.w, self.r, self.m, self.I, self.f, self.t, self.f_ext, self.t_ext)

@@ -21,7 +21,7 @@ the host mirror, the structural edits (spheres, walls, holds, histories), the cl
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import numpy as np
@@ -35,6 +35,7 @@ from .grid import UniformGrid
 from .materials import LUNAR_SOIL_SIMULANT, SOIL_SOIL, SOIL_STEEL, STEEL, Material, PairProperties, effective_modulus
 from .neighbor_list import NeighborList, PairList, row_width
 from .particles import DeviceState, ParticleArrays
+from .sphere_state import SphereState
 from .stepper import Stepper
 from .timestep import TimeStepEstimate, estimate_time_step
 from .walls import MAX_WALLS, Wall, WallArrays
@@ -183,13 +184,7 @@ class Scene:
         #: the particles (granular.fused_step; the same arithmetic, fewer passes over memory).
         self.fuse_steps = True
         # host copy of the state (authoritative while self._device is None)
-        self._x = np.zeros((0, 3))
-        self._v = np.zeros((0, 3))
-        self._w = np.zeros((0, 3))
-        self._r = np.zeros(0)
-        self._mobile = np.zeros(0)  # 1: integrated; 0: held in place (see hold)
-        self._f = np.zeros((0, 3))
-        self._t = np.zeros((0, 3))
+        self._spheres = SphereState.empty()  # the host state (the device's while it steps: _to_host)
         self._hist: ContactHistory | None = None  # the contacts' memory (host copy; None: no contact yet)
         self._device: DeviceParts | None = None
 
@@ -306,13 +301,7 @@ class Scene:
             )
         self._to_host()
         start = self.n_particles
-        self._x = np.concatenate([self._x, x])
-        self._v = np.concatenate([self._v, v])
-        self._w = np.concatenate([self._w, w])
-        self._r = np.concatenate([self._r, r])
-        self._mobile = np.concatenate([self._mobile, np.ones(n)])
-        self._f = np.concatenate([self._f, np.zeros((n, 3))])
-        self._t = np.concatenate([self._t, np.zeros((n, 3))])
+        self._spheres = self._spheres.appended(x, v, w, r)
         given = [None if rows is None else np.asarray(rows, float) for rows in (wall_history, wall_roll_history)]
         for name, rows in zip(("wall_history", "wall_roll_history"), given):
             if rows is not None and rows.shape != (n, len(self.walls), 3):
@@ -339,13 +328,13 @@ class Scene:
         """
         off = _as_array("offset", offset, (3,), 1)[0]
         self._to_host()
-        x = self._x + off
+        x = self._spheres.x + off
         if self.periodic_x:
             x[:, 0] = self._wrapped(x[:, 0])
         outside = np.flatnonzero(np.any((x < self.domain_min) | (x > self.domain_max), axis=1))
         if outside.size:
             raise WheelsoilInputError(f"translating by {off.tolist()} m moves {outside.size} spheres out of the domain")
-        self._x = x
+        self._spheres = replace(self._spheres, x=x)
 
     def contact_history(self) -> ContactHistory:
         """The contacts' memory (:class:`.contact_history.ContactHistory`): each pair's and each wall contact's
@@ -380,8 +369,7 @@ class Scene:
         if mask.shape != (self.n_particles,):
             raise WheelsoilInputError(f"mask has shape {mask.shape}; expected ({self.n_particles},)")
         self._to_host()
-        for name in ("_x", "_v", "_w", "_r", "_mobile", "_f", "_t"):
-            setattr(self, name, getattr(self, name)[mask])
+        self._spheres = self._spheres.kept(mask)
         if self._hist is not None:
             self._hist = self._hist.kept(mask)
         self._renumbered(np.flatnonzero(mask))
@@ -394,35 +382,34 @@ class Scene:
         if mask.shape != (self.n_particles,):
             raise WheelsoilInputError(f"mask has shape {mask.shape}; expected ({self.n_particles},)")
         self._to_host()
-        self._mobile = np.where(mask, 0.0, 1.0)
-        self._v[mask] = 0.0
-        self._w[mask] = 0.0
+        self._spheres = self._spheres.held(mask)
 
     @property
     def held(self) -> np.ndarray:
         """Which spheres are held in place (:meth:`hold`), (N,) bool."""
-        return self._mobile == 0.0
+        return self._spheres.mobile == 0.0
 
     def set_velocities(self, velocities=None, angular_velocities=None) -> None:
         """Overwrite translational [m/s] and/or angular [rad/s] velocities, (N, 3) each."""
         self._to_host()
         if velocities is not None:
-            self._v = _as_array("velocities", velocities, (3,), self.n_particles)
+            self._spheres = replace(self._spheres, v=_as_array("velocities", velocities, (3,), self.n_particles))
         if angular_velocities is not None:
-            self._w = _as_array("angular_velocities", angular_velocities, (3,), self.n_particles)
+            self._spheres = replace(self._spheres, w=_as_array("angular_velocities", angular_velocities, (3,),
+                                                                 self.n_particles))
 
     # ------------------------------------------------------------------ time step
     @property
     def skin(self) -> float:
         if self._skin_request is not None:
             return float(self._skin_request)
-        return 0.15 * 2.0 * float(self._r.min()) if self.n_particles else 0.0
+        return 0.15 * 2.0 * float(self._spheres.r.min()) if self.n_particles else 0.0
 
     def stable_time_step(self, impact_speed: float | None = None) -> TimeStepEstimate:
         """Rayleigh and Hertz estimates for the smallest sphere (see :mod:`.timestep`)."""
         if self.n_particles == 0:
             raise WheelsoilInputError("the scene has no spheres; add some before asking for a time step")
-        r_min = float(self._r.min())
+        r_min = float(self._spheres.r.min())
         wall_moduli = tuple(effective_modulus(self.material, w.material) for w in self.walls)
         wall_moduli += tuple(float(e) for it in self.interactions for e in getattr(it, "contact_moduli", ()))
         return estimate_time_step(
@@ -514,8 +501,7 @@ class Scene:
         exactly this state: a scene restored from it (:meth:`restore_state`) steps bit for bit like this one.
         """
         self._to_host()
-        out = {"x": self._x, "v": self._v, "w": self._w, "f": self._f, "t": self._t, "r": self._r,
-               "mobile": self._mobile}
+        out = self._spheres.to_arrays()
         for key, value in (self._hist.to_arrays() if self._hist is not None else {}).items():
             out[f"hist_{key}"] = value
         out.update({k: getattr(self, k) for k in self._STATE_SCALARS})
@@ -526,16 +512,13 @@ class Scene:
         """Continue from a :meth:`state` of a scene with the same spheres and walls (``same_spheres=False``:
         the state may hold other spheres, e.g. a moving soil patch's; the walls must be the same)."""
         r = np.asarray(state["r"], float)
-        if same_spheres and (r.shape != self._r.shape or not np.array_equal(r, self._r)):
+        if same_spheres and (r.shape != self._spheres.r.shape or not np.array_equal(r, self._spheres.r)):
             raise WheelsoilInputError(
                 f"the saved state has {len(r)} spheres of other radii than this scene's {self.n_particles}; "
                 "it belongs to another bed"
             )
         self._device = None
-        self._r = r.copy()
-        self._mobile = np.array(state["mobile"], float) if "mobile" in state else np.ones(len(r))
-        self._x, self._v, self._w = (np.array(state[k], float) for k in ("x", "v", "w"))
-        self._f, self._t = np.array(state["f"], float), np.array(state["t"], float)
+        self._spheres = SphereState.from_arrays(state)
         hist = {k[5:]: v for k, v in state.items() if k.startswith("hist_")}
         self._hist = ContactHistory.from_arrays(hist) if hist else None
         for k in self._STATE_SCALARS:
@@ -574,7 +557,7 @@ class Scene:
                 f"{self.domain_max.tolist()}] m {where}; the bin may be missing a wall or the run blew up"
             )
         vmax = math.sqrt(vmax2)
-        limit = 0.2 * float(self._r.min()) / self.time_step
+        limit = 0.2 * float(self._spheres.r.min()) / self.time_step
         if vmax > limit:
             raise SimulationUnstableError(
                 f"energy blow-up {where}: a particle moves at {vmax:.3g} m/s, more than 0.2 r_min per step "
@@ -588,7 +571,8 @@ class Scene:
         if self._device is not None:
             return self._device
         n = self.n_particles
-        r_min, r_max = float(self._r.min()), float(self._r.max())
+        s = self._spheres
+        r_min, r_max = float(s.r.min()), float(s.r.max())
         skin = self.skin
         reach = 2.0 * r_max + skin
         cell = reach if self._cell_request is None else float(self._cell_request)
@@ -598,8 +582,7 @@ class Scene:
             )
         grid = UniformGrid.covering(self.domain_min, self.domain_max, cell, period=self.period)
         h = self._hist
-        particles = ParticleArrays.upload(self._x, self._v, self._w, self._f, self._t, self._r, self._mobile,
-                                          self.material.density)
+        particles = ParticleArrays.upload(s.x, s.v, s.w, s.f, s.t, s.r, s.mobile, self.material.density)
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = (PairList.from_history(n, h.pair_i, h.pair_j, h.pair_xi, h.pair_roll) if h is not None
                  else PairList.allocate(n, 1))
@@ -622,15 +605,14 @@ class Scene:
         device = self._device
         if device is None:
             return
-        state = device.particles.download()
-        self._x, self._v, self._w, self._f, self._t = (state[k] for k in ("x", "v", "w", "f", "t"))
+        self._spheres = self._spheres.with_motion(device.particles.download())
         self._hist = ContactHistory(**device.neighbor_list.history(), **device.walls.history())
         self._device = None
 
     # ------------------------------------------------------------------ read-back
     @property
     def n_particles(self) -> int:
-        return int(self._r.shape[0])
+        return len(self._spheres)
 
     def _read(self, key: str, host: np.ndarray) -> np.ndarray:
         if self._device is None:
@@ -640,37 +622,37 @@ class Scene:
     @property
     def positions(self) -> np.ndarray:
         """Sphere centres, (N, 3) [m]."""
-        return self._read("x", self._x)
+        return self._read("x", self._spheres.x)
 
     @property
     def velocities(self) -> np.ndarray:
         """Translational velocities, (N, 3) [m/s]."""
-        return self._read("v", self._v)
+        return self._read("v", self._spheres.v)
 
     @property
     def angular_velocities(self) -> np.ndarray:
         """Angular velocities, (N, 3) [rad/s]."""
-        return self._read("w", self._w)
+        return self._read("w", self._spheres.w)
 
     @property
     def radii(self) -> np.ndarray:
         """Radii, (N,) [m]."""
-        return self._r.copy()
+        return self._spheres.r.copy()
 
     @property
     def masses(self) -> np.ndarray:
         """Masses, (N,) [kg]."""
-        return self.material.density * 4.0 / 3.0 * np.pi * self._r**3
+        return self.material.density * 4.0 / 3.0 * np.pi * self._spheres.r**3
 
     @property
     def contact_forces(self) -> np.ndarray:
         """Sum of contact forces (particles and walls, no gravity) on each sphere, (N, 3) [N]."""
-        return self._read("f", self._f)
+        return self._read("f", self._spheres.f)
 
     @property
     def contact_torques(self) -> np.ndarray:
         """Sum of contact torques about each sphere's centre, (N, 3) [N m]."""
-        return self._read("t", self._t)
+        return self._read("t", self._spheres.t)
 
     @property
     def contact_count(self) -> int:
@@ -680,4 +662,4 @@ class Scene:
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy [J]."""
         v, w, m = self.velocities, self.angular_velocities, self.masses
-        return float(0.5 * np.sum(m * np.sum(v * v, axis=1)) + 0.5 * np.sum(0.4 * m * self._r**2 * np.sum(w * w, axis=1)))
+        return float(0.5 * np.sum(m * np.sum(v * v, axis=1)) + 0.5 * np.sum(0.4 * m * self._spheres.r**2 * np.sum(w * w, axis=1)))
