@@ -78,7 +78,7 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
         drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
         windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
         sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
-        steady_checks=o.steady_checks, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
+        steady_checks=o.steady_checks, steady_drift_confidence=o.steady_drift_confidence, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
         damping=case.wheel.damping, axle_damping=t.axle_damping,
         pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction, case.soil.rolling_model),
     )

@@ -239,6 +239,9 @@ class Output(_Section):
     steady_checks: int = Field(smoke.OUTPUT["steady_checks"], description="consecutive checks, one period of the "
                                "tread apart, that must find the run steady before it stops and is reported steady",
                                **_TEST["steady_checks"].limits())
+    steady_drift_confidence: float = _q(smoke.OUTPUT["steady_drift_confidence"], "1", "standard errors of a "
+                                        "quantity's drift added to it before it is held to steady_tolerance (0: the "
+                                        "estimate alone)", _TEST["steady_drift_confidence"])
     # what a run keeps (cases.run's own: no solver spec carries these two)
     frame_interval: float = _q(smoke.OUTPUT["frame_interval"], "s", "simulated time between frames (particles, "
                                "wheel nodes) kept in the result; 0: the last frame only", non_negative())
@@ -280,4 +283,6 @@ class CaseFile(BaseModel):
             data["soil"].pop("pour_friction_factor")
         if data["soil"]["rolling_model"] == "cdt":
             data["soil"].pop("rolling_model")
+        if data["output"]["steady_drift_confidence"] == 0.0:
+            data["output"].pop("steady_drift_confidence")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

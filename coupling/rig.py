@@ -69,6 +69,9 @@ class TestbedSpec:
         stops and is reported steady. The detector is asked again every period, so one lucky window would let
         a drift comparable to its noise through sooner or later; two in a row cut that several-fold for a
         period's more driving (``docs/steady-detector.md``).
+    steady_drift_confidence: standard errors of each quantity's drift (and of the change between the window's
+        halves) added to it before it is held to ``steady_tolerance`` (0: the estimate alone; 0.5 or 1: a window
+        too short to tell its drift from the tolerance is not called steady; ``docs/steady-drift-confidence.md``).
     start_x: initial hub position along the bin [m] (default: one wheel radius plus 0.1 m from the start;
         on a periodic bed, as near the start as the moving patch allows).
     rigid: use the rigid wheel with the same surface instead of the flexible one.
@@ -107,6 +110,7 @@ class TestbedSpec:
     steady_tolerance: float = smoke.OUTPUT["steady_tolerance"]
     slip_tolerance: float = smoke.OUTPUT["slip_tolerance"]
     steady_checks: int = smoke.OUTPUT["steady_checks"]
+    steady_drift_confidence: float = smoke.OUTPUT["steady_drift_confidence"]
     start_x: float | None = None
     rigid: bool = smoke.WHEEL["rigid"]
     damping: float = smoke.WHEEL["damping"]
@@ -134,6 +138,7 @@ class TestbedSpec:
         "steady_tolerance": positive(hi=1.0),
         "slip_tolerance": positive(hi=0.5),
         "steady_checks": Range(1, 10, integer=True),
+        "steady_drift_confidence": Range(0.0, 3.0),
         "start_x": positive(),
         "damping": non_negative(),
         "axle_damping": non_negative(),

@@ -17,7 +17,7 @@ from .steady import SteadyState, detect_steady_state, window_stats
 def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: float, average_time: float,
                      steady_tolerance: float, slip_tolerance: float, radius: float, pitch: float,
                      mean_diameter: float, sample_interval: float, start: float, period_pitches: int = 1,
-                     truncation_search: float = 0.5) -> SteadyState:
+                     truncation_search: float = 0.5, drift_confidence: float = 0.0) -> SteadyState:
     """The testbed's steady-state verdict on its series ``rows`` (name -> per-sample values, the columns of
     :data:`SERIES_UNITS`) -- what a running testbed asks once per pitch, and what a stored run's ``series.csv``
     can be asked again (``docs/steady_replay.py``).
@@ -28,7 +28,7 @@ def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: 
     period_pitches (its whole period in batches): the wheel's; mean_diameter [m]: the soil's mean particle
     diameter (half of it is the sinkage's floor); sample_interval [s]; start [s]: earliest window start.
     The floors of the relative tolerance are 5 % of W for the forces, 5 % of W r for the torque.
-    truncation_search: see :func:`~.steady.detect_steady_state`.
+    truncation_search, drift_confidence: see :func:`~.steady.detect_steady_state`.
     """
     series = {q: np.asarray(rows[q], float) for q in STEADY_CHECKED}
     floors = {"drawbar_pull": 0.05 * load, "lateral_force": 0.05 * load, "vertical_force": 0.05 * load,
@@ -53,7 +53,7 @@ def detect_from_rows(rows: dict, *, slip: float, load: float, angular_velocity: 
         pitch=pitch, start=start,
         min_pitches=min_pitches, tolerance=steady_tolerance, floors=floors, slip_target=slip,
         slip_tolerance=slip_tolerance, sample_interval=sample_interval, period_pitches=period_pitches,
-        truncation_search=truncation_search)
+        truncation_search=truncation_search, drift_confidence=drift_confidence)
 
 
 def summarise_window(rows: dict, state: SteadyState, k0: int, k1: int, *, period_pitches: int, sample_interval: float,

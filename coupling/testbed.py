@@ -334,7 +334,7 @@ class Testbed:
             steady_tolerance=s.steady_tolerance, slip_tolerance=s.slip_tolerance, radius=self.wheel.radius,
             pitch=self.pitch, mean_diameter=0.5 * (self.bed.spec.diameter_min + self.bed.spec.diameter_max),
             sample_interval=self.steps_per_sample * self.dt, start=self._loop.t_average_from,
-            period_pitches=self.period_pitches)
+            period_pitches=self.period_pitches, drift_confidence=s.steady_drift_confidence)
 
     # ------------------------------------------------------------------ checkpoints
     def state(self) -> dict:

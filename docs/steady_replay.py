@@ -39,10 +39,12 @@ def read_series(path: Path) -> dict:
     return {name: data[:, j] for j, name in enumerate(names)}
 
 
-def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = True):
+def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = True,
+           drift_confidence: float | None = None):
     """The verdict that would have ended the stored run (or the last one by its stored end), the time of that
     check [s] and how many checks were made. ``whole_periods=False``: every batch taken for a whole period of
-    the wheel (the detector before it knew the period of a wheel whose grousers and spokes differ)."""
+    the wheel (the detector before it knew the period of a wheel whose grousers and spokes differ);
+    ``drift_confidence``: the detector's (None: the case's ``output.steady_drift_confidence``)."""
     case = load_case(run_dir / "case.toml")
     spec, bed, wheel = build.testbed_spec(case), build.bed_spec(case), build.wheel_geometry(case)
     run = json.loads((run_dir / "summary.json").read_text())["run"]
@@ -58,7 +60,8 @@ def replay(run_dir: Path, truncation_search: float = 0.5, whole_periods: bool = 
                   average_time=spec.average_time, steady_tolerance=spec.steady_tolerance,
                   slip_tolerance=spec.slip_tolerance, radius=wheel.radius, pitch=pitch,
                   mean_diameter=0.5 * (bed.diameter_min + bed.diameter_max), sample_interval=dt_sample, start=start,
-                  period_pitches=periods)
+                  period_pitches=periods,
+                  drift_confidence=spec.steady_drift_confidence if drift_confidence is None else drift_confidence)
     state, in_a_row, checks, t_check = None, 0, 0, math.nan
     for k in range(len(t)):
         if t[k] < check - 1e-12:
@@ -80,6 +83,8 @@ def main() -> None:
     p.add_argument("runs", type=Path, nargs="+", help="run folders (series.csv, summary.json, case.toml)")
     p.add_argument("--truncation-search", type=float, default=0.5,
                    help="fraction of the pitches MSER searches for the transient's end (default 0.5)")
+    p.add_argument("--drift-confidence", type=float, default=None,
+                   help="standard errors added to each drift before the tolerance (default: the case's own)")
     p.add_argument("--batch-is-period", action="store_true",
                    help="take every batch for a whole period of the wheel (the detector before)")
     args = p.parse_args()
@@ -88,7 +93,7 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|---|---|")
     for run_dir in args.runs:
         stored = json.loads((run_dir / "summary.json").read_text())["summary"]
-        state, _, _ = replay(run_dir, args.truncation_search, not args.batch_is_period)
+        state, _, _ = replay(run_dir, args.truncation_search, not args.batch_is_period, args.drift_confidence)
         dp, fy = state.stats.get("drawbar_pull", {}), state.stats.get("lateral_force", {})
         print(f"| {run_dir.name} | {'yes' if stored['steady'] else 'no'}, "
               f"{stored['window'][0]:.2f}–{stored['window'][1]:.2f} | {'yes' if state.steady else 'no'} | "

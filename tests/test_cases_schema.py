@@ -209,3 +209,15 @@ def test_the_readme_example_case_is_the_preset_it_says(tmp_path):
     path = tmp_path / "example.toml"
     path.write_text(m.group(2))
     assert load_case(path, name=m.group(1)).case_hash() == load_case(m.group(1)).case_hash()
+
+
+def test_steady_drift_confidence_reaches_the_rig_and_leaves_stored_hashes_alone():
+    """output.steady_drift_confidence (added 2026-11-28) reaches the rig's spec; at its default of 0 a case keeps the
+    hash it had before the key existed (stored runs are not rerun), and any other value is another case."""
+    plain = load_case("smoke-1g-steer")
+    explicit = load_case("smoke-1g-steer", ["output.steady_drift_confidence=0"])
+    strict = load_case("smoke-1g-steer", ["output.steady_drift_confidence=0.5"])
+    assert plain.case_hash() == explicit.case_hash() != strict.case_hash()
+    assert build.testbed_spec(strict).steady_drift_confidence == 0.5
+    with pytest.raises(CaseError, match="steady_drift_confidence"):
+        load_case("smoke-1g-steer", ["output.steady_drift_confidence=-1"])

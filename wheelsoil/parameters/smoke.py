@@ -61,6 +61,7 @@ OUTPUT = dict(
     steady_tolerance=0.1,
     slip_tolerance=0.03,
     steady_checks=2,
+    steady_drift_confidence=0.0,  # standard errors of a drift added before it is held to the tolerance
     frame_interval=0.05,     # s
     checkpoint_interval=0.25,  # s
     render=True,
