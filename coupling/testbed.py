@@ -66,15 +66,16 @@ from wheelsoil.granular.bed import Bed
 from .contact import WheelContact
 from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg, yaw_matrix
 from .patch import MovingPatch
+from .placement import wheel_start_centre
 from .protocol import DEFAULT_PROTOCOL, advance, step_named
 from .protocol_state import ProtocolState
 from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig, soil_headroom,
                   statistics_pitch)
 from .run_progress import RunProgress
-from .run_statistics import detect_from_rows, summarise_window
+from .run_statistics import detect_from_rows
 from .run_summary import SERIES_UNITS
 from .steady import SteadyState
-from .testbed_result import TestbedResult
+from .testbed_result import TestbedResult, testbed_result
 
 
 class Testbed:
@@ -95,24 +96,8 @@ class Testbed:
 
     def __init__(self, bed: Bed | str | Path, wheel: WheelGeometry | None = None, spec: TestbedSpec | None = None, *,
                  arch: str | None = None, plan: RigPlan | None = None) -> None:
-        if isinstance(bed, (str, Path)):
-            if not Path(bed).is_file():
-                raise WheelsoilInputError(f"bed file {str(bed)!r} does not exist; prepare it with 'wheelsoil prepare-bed'")
-            bed = Bed.load(bed)
-        if not isinstance(bed, Bed):
-            raise WheelsoilInputError(f"bed must be a Bed or a bed file path, got {type(bed).__name__}")
-        if plan is not None:  # checked already (plan_rig): the plan's wheel and rig, on the bed it was made for
-            if wheel is not None or spec is not None:
-                raise WheelsoilInputError("give the testbed either a plan or a wheel and spec, not both")
-            if plan.bed != bed.spec:
-                raise WheelsoilInputError("the bed is not the one the plan was made for: prepare the plan's bed "
-                                          "(prepare_bed(plan.bed)) or plan for this one (plan_rig(bed.spec, ...))")
-            wheel, spec = plan.wheel, plan.test
-        elif not isinstance(wheel, WheelGeometry):
-            raise WheelsoilInputError(f"wheel must be a WheelGeometry, got {type(wheel).__name__}")
-        spec = spec or TestbedSpec()
-        if plan is None:
-            plan = plan_rig(bed.spec, wheel, spec)
+        bed, plan = _bed_and_plan(bed, wheel, spec, plan)
+        wheel, spec = plan.wheel, plan.test
         self.bed, self.wheel, self.spec = bed, wheel, spec
         bs = bed.spec
         beta = math.radians(spec.slip_angle)
@@ -138,15 +123,9 @@ class Testbed:
         # ---- the wheel, yawed by -beta and placed just above the surface
         mesh, hub_nodes = build_wheel_mesh(wheel)
         self.yaw = yaw_matrix(-beta)
-        gap = 0.25 * bs.diameter_min
         nodes = mesh.nodes @ self.yaw.T
-        center = np.array([start_x, 0.5 * bs.width, 0.0])
-        # lowest point of the wheel just above the highest sphere beneath it (not the mean surface:
-        # spheres stand proud of it by up to a radius, and a deep first overlap would kick the tread)
-        lo, hi = (nodes + center)[:, :2].min(axis=0), (nodes + center)[:, :2].max(axis=0)
-        below = np.all((bed.positions[:, :2] >= lo - bs.diameter_max) & (bed.positions[:, :2] <= hi + bs.diameter_max), axis=1)
-        top = float(np.max(bed.positions[below, 2] + bed.radii[below])) if below.any() else bed.surface_height
-        center[2] = top - nodes[:, 2].min() + gap
+        center = wheel_start_centre(nodes, bed.positions, bed.radii, start_x, bs.width, bs.diameter_max,
+                                    bed.surface_height, gap=0.25 * bs.diameter_min)
         mesh.nodes = nodes + center
         self.mesh = mesh
         tread = mesh.part_names.index("tread") if "tread" in mesh.part_names else None
@@ -234,7 +213,7 @@ class Testbed:
         self.scene.check_health()
         self.structure.check_health()
         self._loop.phase = "done"
-        return self._result({k: np.asarray(v) for k, v in self.rows.items()}, time.perf_counter() - wall)
+        return testbed_result(self, {k: np.asarray(v) for k, v in self.rows.items()}, time.perf_counter() - wall)
 
     def _start(self) -> None:
         s = self.spec
@@ -366,44 +345,6 @@ class Testbed:
         self._loop = ProtocolState.from_dict(state["testbed"]["loop"])
         self.rows = {k: [float(v) for v in np.asarray(rows[k])] for k in SERIES_UNITS}
 
-    # ------------------------------------------------------------------ the result
-    def _result(self, rows: dict, wall: float) -> TestbedResult:
-        s, loop = self.spec, self._loop
-        state = self.steady_state if self.steady_state is not None else self.detect()
-        t = rows["t"]
-        k0, k1 = state.k0, state.k1
-        if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
-            k1 = len(t)
-            k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
-        summary = summarise_window(rows, state, k0, k1, period_pitches=self.period_pitches,
-                                   sample_interval=self.steps_per_sample * self.dt, pitch=self.pitch,
-                                   commanded_slip=s.slip, commanded_slip_angle=s.slip_angle)
-        particles = {"position": self.scene.positions, "velocity": self.scene.velocities, "radius": self.scene.radii}
-        nodes = self.structure.positions()
-        info = {
-            "wall_seconds": wall,
-            "simulated_seconds": float(t[-1]),
-            "dem_steps": self.scene.steps_taken,
-            "dem_time_step": self.dt,
-            "fe_substeps": self.contact.structure_substeps,
-            "fe_time_step": self.structure.stable_time_step,
-            "particles": self.scene.n_particles,
-            "fe_elements": int(self.mesh.n_elements),
-            "contact_facets": int(self.contact.surface.n_facets),
-            "wheel_mass": self.wheel_mass,
-            "contact_rebuilds": self.contact.rebuilds,
-            "seconds_per_simulated_second": wall / max(float(t[-1]), 1e-12),
-            "t_released": loop.t_release, "t_spin_up": loop.t_spin, "t_wind_up": loop.t_windup,
-            "t_hold": loop.t_hold, "wind_up_converged": bool(loop.windup_converged),
-            "patch_shifts": int(self.patch.shifts) if self.patch is not None else 0,
-            # grains launched above the soil's domain at one health check, at most (Scene.check_health)
-            "most_grains_above_top": int(self.scene.most_above_top),
-            "patch_thrown_out": int(self.patch.thrown_out) if self.patch is not None else 0,
-        }
-        return TestbedResult(series=rows, summary=summary, spec=s, wheel=self.wheel, bed_summary=self.bed.summary(),
-                             info=info, final_particles=particles, final_wheel_nodes=nodes,
-                             final_deformation=self.deformation(nodes), mesh=self.mesh)
-
     def deformation(self, nodes: np.ndarray | None = None) -> np.ndarray:
         """The wheel's deformation [m] (N, 3): node positions less the wheel's best-fit rigid motion from its
         start pose, the fit weighted by the nodes' lumped masses (:func:`.kinematics.deformation`)."""
@@ -411,3 +352,25 @@ class Testbed:
         weights = np.maximum(self.structure.mass, 0.0)
         weights[self.structure.hub_nodes] += self.wheel.hub_mass / max(len(self.structure.hub_nodes), 1)
         return deformation(nodes, self.mesh.nodes, weights)
+
+
+def _bed_and_plan(bed: Bed | str | Path, wheel: WheelGeometry | None, spec: TestbedSpec | None,
+                  plan: RigPlan | None) -> tuple[Bed, RigPlan]:
+    """The bed (loaded where a file is given) and the rig's checked plan: ``plan`` as given, on the bed it was made
+    for, or planned here from ``wheel`` and ``spec`` (default :class:`~.rig.TestbedSpec`)."""
+    if isinstance(bed, (str, Path)):
+        if not Path(bed).is_file():
+            raise WheelsoilInputError(f"bed file {str(bed)!r} does not exist; prepare it with 'wheelsoil prepare-bed'")
+        bed = Bed.load(bed)
+    if not isinstance(bed, Bed):
+        raise WheelsoilInputError(f"bed must be a Bed or a bed file path, got {type(bed).__name__}")
+    if plan is not None:  # checked already (plan_rig): the plan's wheel and rig, on the bed it was made for
+        if wheel is not None or spec is not None:
+            raise WheelsoilInputError("give the testbed either a plan or a wheel and spec, not both")
+        if plan.bed != bed.spec:
+            raise WheelsoilInputError("the bed is not the one the plan was made for: prepare the plan's bed "
+                                      "(prepare_bed(plan.bed)) or plan for this one (plan_rig(bed.spec, ...))")
+        return bed, plan
+    if not isinstance(wheel, WheelGeometry):
+        raise WheelsoilInputError(f"wheel must be a WheelGeometry, got {type(wheel).__name__}")
+    return bed, plan_rig(bed.spec, wheel, spec or TestbedSpec())

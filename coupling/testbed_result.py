@@ -11,6 +11,7 @@ from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.flexwheel.mesh import StructureMesh
 
 from .rig import TestbedSpec
+from .run_statistics import summarise_window
 from .run_summary import RunSummary
 
 
@@ -34,3 +35,44 @@ class TestbedResult:
     def steady(self, name: str) -> float:
         """Steady-state mean of a quantity (see :data:`~.run_summary.SUMMARY_QUANTITIES`)."""
         return self.summary.mean(name)
+
+
+def testbed_result(bench, rows: dict, wall: float) -> TestbedResult:
+    """What a finished :class:`~.testbed.Testbed` run returns: its series ``rows`` (NumPy arrays), the summary over the
+    steady window it found (or, where none, over the drive's last ``average_time``, said to be unsteady), the run's
+    figures (``wall`` [s] of wall time) and its last state."""
+    s, loop = bench.spec, bench.protocol_state
+    state = bench.steady_state if bench.steady_state is not None else bench.detect()
+    t = rows["t"]
+    k0, k1 = state.k0, state.k1
+    if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
+        k1 = len(t)
+        k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
+    summary = summarise_window(rows, state, k0, k1, period_pitches=bench.period_pitches,
+                               sample_interval=bench.steps_per_sample * bench.dt, pitch=bench.pitch,
+                               commanded_slip=s.slip, commanded_slip_angle=s.slip_angle)
+    particles = {"position": bench.scene.positions, "velocity": bench.scene.velocities, "radius": bench.scene.radii}
+    nodes = bench.structure.positions()
+    info = {
+        "wall_seconds": wall,
+        "simulated_seconds": float(t[-1]),
+        "dem_steps": bench.scene.steps_taken,
+        "dem_time_step": bench.dt,
+        "fe_substeps": bench.contact.structure_substeps,
+        "fe_time_step": bench.structure.stable_time_step,
+        "particles": bench.scene.n_particles,
+        "fe_elements": int(bench.mesh.n_elements),
+        "contact_facets": int(bench.contact.surface.n_facets),
+        "wheel_mass": bench.wheel_mass,
+        "contact_rebuilds": bench.contact.rebuilds,
+        "seconds_per_simulated_second": wall / max(float(t[-1]), 1e-12),
+        "t_released": loop.t_release, "t_spin_up": loop.t_spin, "t_wind_up": loop.t_windup,
+        "t_hold": loop.t_hold, "wind_up_converged": bool(loop.windup_converged),
+        "patch_shifts": int(bench.patch.shifts) if bench.patch is not None else 0,
+        # grains launched above the soil's domain at one health check, at most (Scene.check_health)
+        "most_grains_above_top": int(bench.scene.most_above_top),
+        "patch_thrown_out": int(bench.patch.thrown_out) if bench.patch is not None else 0,
+    }
+    return TestbedResult(series=rows, summary=summary, spec=s, wheel=bench.wheel, bed_summary=bench.bed.summary(),
+                         info=info, final_particles=particles, final_wheel_nodes=nodes,
+                         final_deformation=bench.deformation(nodes), mesh=bench.mesh)
