@@ -208,15 +208,21 @@ def report(rows: list[dict], seeds: int, seconds: float) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def campaign_main(description: str, default_report: Path, run, write) -> None:
+    """The command line of a synthetic-run campaign: ``--seeds`` and ``--report``; ``run(seeds)`` gives the rows,
+    ``write(rows, seeds, seconds)`` the report's text."""
+    p = argparse.ArgumentParser(description=description)
     p.add_argument("--seeds", type=int, default=200)
-    p.add_argument("--report", type=Path, default=ROOT / "steady-detector.md")
+    p.add_argument("--report", type=Path, default=default_report)
     args = p.parse_args()
     t0 = time.perf_counter()
-    rows = campaign(args.seeds)
-    args.report.write_text(report(rows, args.seeds, time.perf_counter() - t0))
+    rows = run(args.seeds)
+    args.report.write_text(write(rows, args.seeds, time.perf_counter() - t0))
     print(f"wrote {args.report}")
+
+
+def main() -> None:
+    campaign_main(__doc__.split("\n")[0], ROOT / "steady-detector.md", campaign, report)
 
 
 if __name__ == "__main__":

@@ -27,8 +27,6 @@ Usage (from the repository root; about 15 minutes on one core)::
     python docs/steady_drift_confidence.py [--seeds 200]
 """
 
-import argparse
-import time
 from pathlib import Path
 
 import numpy as np
@@ -100,14 +98,7 @@ def report(rows: list[dict], seeds: int, seconds: float) -> str:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--seeds", type=int, default=200)
-    p.add_argument("--report", type=Path, default=ROOT / "steady-drift-confidence.md")
-    args = p.parse_args()
-    t0 = time.perf_counter()
-    rows = campaign(args.seeds)
-    args.report.write_text(report(rows, args.seeds, time.perf_counter() - t0))
-    print(f"wrote {args.report}")
+    smoke.campaign_main(__doc__.split("\n")[0], ROOT / "steady-drift-confidence.md", campaign, report)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,12 @@ Z_MAX = 0.05
 TOLERANCE = 1e-10
 
 
+def random_power_laws(seed, count, log_k=(4, 7), n=(0.5, 1.6), load=(5.0, 500.0)):
+    """``count`` power laws F_z = k z^n with k, n and W drawn uniformly (k in log) from the given ranges: k, n, W."""
+    rng = np.random.default_rng(seed)
+    return 10 ** rng.uniform(*log_k, count), rng.uniform(*n, count), rng.uniform(*load, count)
+
+
 def power_law(k, n, load):
     """excess(z, rows) for F_z = k z^n - W, and the closed-form roots."""
     def excess(z, rows):
@@ -23,10 +29,8 @@ def power_law(k, n, load):
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_cold_solve_finds_the_closed_form_root_and_flags_unsupported_loads(seed):
-    rng = np.random.default_rng(seed)
     count = 200
-    k, n = 10 ** rng.uniform(4, 7, count), rng.uniform(0.5, 1.6, count)
-    load = rng.uniform(5.0, 500.0, count)
+    k, n, load = random_power_laws(seed, count)
     excess, root = power_law(k, n, load)
     sol = solve_sinkage(excess, load, Z_MAX, tolerance=TOLERANCE)
     carried = k * Z_MAX ** n >= load
@@ -39,10 +43,8 @@ def test_cold_solve_finds_the_closed_form_root_and_flags_unsupported_loads(seed)
 
 @pytest.mark.parametrize("seed", [3, 4])
 def test_a_warm_start_near_the_root_takes_few_evaluations_and_agrees_with_a_cold_solve(seed):
-    rng = np.random.default_rng(seed)
     count = 100
-    k, n = 10 ** rng.uniform(5, 6, count), rng.uniform(0.6, 1.4, count)
-    load = rng.uniform(10.0, 100.0, count)
+    k, n, load = random_power_laws(seed, count, log_k=(5, 6), n=(0.6, 1.4), load=(10.0, 100.0))
     warm = SinkageWarmStart()
     excess, _ = power_law(k, n, load)
     first = solve_sinkage(excess, load, Z_MAX, tolerance=TOLERANCE, warm=warm)
@@ -60,11 +62,10 @@ def test_a_warm_start_near_the_root_takes_few_evaluations_and_agrees_with_a_cold
 
 @pytest.mark.parametrize("seed", [5, 6])
 def test_a_bad_warm_start_costs_evaluations_not_the_answer(seed):
-    rng = np.random.default_rng(seed)
     count = 100
-    k, n = 10 ** rng.uniform(4, 7, count), rng.uniform(0.5, 1.6, count)
-    load = rng.uniform(5.0, 500.0, count)
+    k, n, load = random_power_laws(seed, count)
     excess, root = power_law(k, n, load)
+    rng = np.random.default_rng(seed + 100)
     warm = SinkageWarmStart(sinkage=rng.uniform(0.0, 2 * Z_MAX, count), stiffness=rng.uniform(-1e6, 1e6, count))
     hot = solve_sinkage(excess, load, Z_MAX, tolerance=TOLERANCE, warm=warm)
     cold = solve_sinkage(excess, load, Z_MAX, tolerance=TOLERANCE)
