@@ -72,8 +72,10 @@ class SphereState:
         return SphereState(*(getattr(self, name)[mask] for name in STATE_ARRAYS))
 
     def with_motion(self, motion: SphereMotion) -> SphereState:
-        """The same spheres with the device's motion copied back."""
-        return replace(self, x=motion.x, v=motion.v, w=motion.w, f=motion.f, t=motion.t)
+        """The same spheres with the device's motion copied back (its first N rows: a device array holds at least
+        one row, even for a scene without spheres)."""
+        n = len(self)
+        return replace(self, x=motion.x[:n], v=motion.v[:n], w=motion.w[:n], f=motion.f[:n], t=motion.t[:n])
 
     def held(self, mask: np.ndarray) -> SphereState:
         """Spheres where ``mask`` is true held in place (at rest, not integrated), all others set free."""

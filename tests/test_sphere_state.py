@@ -36,6 +36,8 @@ def test_kept_held_and_motion_edit_every_array_alike():
     motion = SphereMotion(*(np.full((3, 3), k, float) for k in range(5)))
     moved = s.with_motion(motion)
     assert moved.t[0, 0] == 4.0 and moved.r is s.r
+    # an empty scene's device arrays hold one row: none of it comes back
+    assert len(SphereState.empty().with_motion(SphereMotion(*(np.zeros((1, 3)) for _ in range(5))))) == 0
 
 
 def test_a_checkpoint_round_trips_and_an_old_one_without_mobility_frees_every_sphere():
