@@ -266,13 +266,13 @@ def _quantity_reasons(name: str, st: dict, tolerance: float, floors: dict, zero_
             return [f"{name} is zero within its noise ({st['mean']:+.3g} +- {st['sem']:.2g}) but trends: "
                     f"drift {st['drift']:+.4g} +- {st['drift_sem']:.2g}, change between the window's halves "
                     f"{st['step']:+.4g} +- {st['step_sem']:.2g} (allowed: {zero_within:g} standard errors)"]
-    elif abs(st["drift"]) + _margin(drift_confidence, st["drift_sem"]) > allowed:
-        margin = f" plus {drift_confidence:g} standard errors" if drift_confidence else ""
+        return []
+    margin = f" plus {drift_confidence:g} standard errors" if drift_confidence else ""
+    if abs(st["drift"]) + _margin(drift_confidence, st["drift_sem"]) > allowed:
         return [f"{name} drifts by {st['drift']:+.4g} +- {st['drift_sem']:.2g} over the window (allowed "
                 f"+-{allowed:.3g}{margin})" + ("; within its own noise: a longer window would tell"
                                                if abs(st["drift"]) < 2.0 * st["drift_sem"] else "")]
     elif abs(st["step"]) + _margin(drift_confidence, st["step_sem"]) > allowed:
-        margin = f" plus {drift_confidence:g} standard errors" if drift_confidence else ""
         return [f"{name} changes by {st['step']:+.4g} +- {st['step_sem']:.2g} between the window's halves (allowed "
                 f"+-{allowed:.3g}{margin})"]
     return []

@@ -50,9 +50,7 @@ def smoke_case(seed: int, drift: float, checks: int, k: float):
 def twin_case(drive: float):
     def case(seed: int, drift: float, checks: int, k: float):
         t, series, angle = twin.synthetic_run(20_000 + seed, drift, drive)
-        state = smoke.first_verdict(t, series, angle, 2.0, checks, 0.5, t_hold=twin.T_HOLD, pitch=twin.PITCH,
-                                    omega=twin.OMEGA, radius=twin.RADIUS, average_time=twin.AVERAGE_TIME,
-                                    floors=twin.FLOORS, dt=twin.DT, period_pitches=twin.PERIOD, drift_confidence=k)
+        state = twin.twin_verdict(t, series, angle, checks, k)
         mean = twin.QUANTITIES["drawbar_pull"][0]
         return state, "drawbar_pull", lambda t_end: mean + drift * mean * (t_end - twin.T_HOLD)
     return case

@@ -51,11 +51,17 @@ def synthetic_run(seed: int, drift: float, drive: float):
     return t, series, OMEGA * t
 
 
+def twin_verdict(t, series, angle, checks: int = 2, drift_confidence: float = 0.0):
+    """The verdict that ends the run when the testbed asks as it does (:func:`steady_campaign.first_verdict`) in the
+    twin's regime, with ``checks`` steady verdicts in a row and the detector's ``drift_confidence``."""
+    return first_verdict(t, series, angle, 2.0, checks, 0.5, t_hold=T_HOLD, pitch=PITCH, omega=OMEGA, radius=RADIUS,
+                         average_time=AVERAGE_TIME, floors=FLOORS, dt=DT, period_pitches=PERIOD,
+                         drift_confidence=drift_confidence)
+
+
 def verdict(t, series, angle) -> bool:
-    """Whether the testbed's two-in-a-row rule ends the run steady (:func:`steady_campaign.first_verdict` in the twin's
-    regime)."""
-    state = first_verdict(t, series, angle, 2.0, 2, 0.5, t_hold=T_HOLD, pitch=PITCH, omega=OMEGA, radius=RADIUS,
-                          average_time=AVERAGE_TIME, floors=FLOORS, dt=DT, period_pitches=PERIOD)
+    """Whether the testbed's two-in-a-row rule ends the run steady (:func:`twin_verdict` with the defaults)."""
+    state = twin_verdict(t, series, angle)
     return bool(state is not None and state.steady)
 
 
