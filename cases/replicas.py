@@ -12,7 +12,15 @@ on one bed per seed (a sweep over ``case.seed``: finished replicas are kept) and
   interval says the runs' error bars are too small by that much;
 * the **coverage**: how many runs' own 95 % intervals (``ci95``, Student's t) hold the mean of the other replicas,
   with the interval widened by sqrt(1 + 1 / (n - 1)) for that mean's own scatter; an honest interval holds it in
-  about 95 % of runs.
+  about 95 % of runs;
+* the spread **between beds**, sigma_b = sqrt(max(0, s^2 - mean(sem^2))): the part of the spread that no error bar
+  from within one run can see (a one-way random-effects model, method of moments), and the **replicas' mean with its
+  95 % interval**, t(0.975, n - 1) s / sqrt(n): the error bar the replicas give a number;
+* with factors from another replica set of n_f runs (``--widen-by REPLICAS_JSON``, :class:`Widening`: per quantity
+  f = max(1, its inflation)), the coverage of the runs' intervals widened to t(0.975, n_f - 1) f sem: the check, on
+  replicas not used to set the factors, that a widened single-run interval holds as often as it claims. Student's t
+  at n_f - 1 degrees of freedom carries the factor's own scatter: f sem is an estimate of the spread from n_f runs,
+  so a normal 1.96 f sem would hold only about 88 % of the time with n_f = 5 (tests/test_cases_replicas.py).
 
 Only steady runs count; runs that are not steady are listed.
 """
@@ -21,10 +29,12 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
+from scipy.stats import t as student_t
 
 from wheelsoil.coupling.run_summary import RunSummary
 from wheelsoil.errors import WheelsoilInputError
@@ -71,8 +81,40 @@ def _summaries(sweep: Sweep) -> list[tuple[int, RunSummary | None]]:
     return out
 
 
-def replica_statistics(summaries: list[tuple[int, RunSummary | None]]) -> dict:
-    """The replicas' statistics (see the module docstring) from (seed, summary or None) pairs."""
+@dataclass(frozen=True)
+class Widening:
+    """Per quantity the factor f = max(1, inflation) that a replica set of ``replicas`` runs measured (1 where it
+    measured none), read from its ``replicas.json`` (``source``)."""
+
+    factors: dict[str, float]
+    replicas: int
+    source: str
+
+    @classmethod
+    def read(cls, path: str | Path) -> "Widening":
+        path = Path(path)
+        try:
+            stats = json.loads(path.read_text())
+            quantities, replicas = stats["quantities"], len(stats["steady"])
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise WheelsoilInputError(f"--widen-by {path}: not a replicas.json written by 'wheelsoil replicate' "
+                                      f"({type(exc).__name__}: {exc})") from None
+        if replicas < 2:
+            raise WheelsoilInputError(f"--widen-by {path}: {replicas} steady replicas; a factor needs at least two")
+        factors = {}
+        for q in QUANTITIES:
+            f = quantities.get(q, {}).get("inflation", math.nan)
+            factors[q] = max(1.0, float(f)) if f is not None and math.isfinite(float(f)) else 1.0
+        return cls(factors, replicas, str(path))
+
+    def half_width(self, quantity: str, sem):
+        """The widened 95 % half-width t(0.975, n_f - 1) f sem (units of ``sem``)."""
+        return float(student_t.ppf(0.975, self.replicas - 1)) * self.factors[quantity] * np.asarray(sem, float)
+
+
+def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening: Widening | None = None) -> dict:
+    """The replicas' statistics (see the module docstring) from (seed, summary or None) pairs; ``widening``: the
+    factors of another replica set whose widened intervals to check."""
     done = [(s, m) for s, m in summaries if m is not None]
     steady = [(s, m) for s, m in done if m.steady]
     result = {"seeds": [s for s, _ in summaries], "finished": [s for s, _ in done],
@@ -91,17 +133,25 @@ def replica_statistics(summaries: list[tuple[int, RunSummary | None]]) -> dict:
                        inflation=sd / rms if rms > 0 else math.nan,
                        inflation_interval=[sd * math.sqrt((n - 1) / lo) / rms, sd * math.sqrt((n - 1) / hi) / rms]
                        if rms > 0 else [math.nan, math.nan])
+            between = math.sqrt(max(0.0, sd * sd - float(np.mean(sem ** 2)))) if math.isfinite(rms) else math.nan
+            row.update(between_beds=between, mean_ci95=float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n))
             others = np.array([(x.sum() - x[k]) / (n - 1) for k in range(n)])
-            held = np.abs(x - others) <= ci * math.sqrt(1.0 + 1.0 / (n - 1))
+            reach = np.abs(x - others) / math.sqrt(1.0 + 1.0 / (n - 1))
             known = np.isfinite(ci)
-            row.update(covered=int(np.sum(held & known)), coverage_runs=int(known.sum()))
+            row.update(covered=int(np.sum((reach <= ci) & known)), coverage_runs=int(known.sum()))
+            if widening is not None:
+                row.update(factor=widening.factors[q],
+                           covered_widened=int(np.sum((reach <= widening.half_width(q, sem)) & known)))
         result["quantities"][q] = row
     return result
 
 
-def write_report(sweep: Sweep, base: CaseFile) -> list[Path]:
-    """replicas.json and replicas.md in the sweep folder."""
-    stats = replica_statistics(_summaries(sweep))
+def write_report(sweep: Sweep, base: CaseFile, widen_by: str | Path | None = None) -> list[Path]:
+    """replicas.json and replicas.md in the sweep folder (``widen_by``: a replicas.json whose factors to check)."""
+    widening = Widening.read(widen_by) if widen_by is not None else None
+    stats = replica_statistics(_summaries(sweep), widening)
+    if widening is not None:
+        stats["widened_by"] = {"source": widening.source, "replicas": widening.replicas, "factors": widening.factors}
     sweep.out.mkdir(parents=True, exist_ok=True)
     with atomic_output(sweep.out / "replicas.json") as tmp:
         tmp.write_text(json.dumps({"case": base.name, **stats}, indent=2, default=float))
@@ -119,15 +169,25 @@ def report_markdown(name: str, stats: dict) -> str:
              "Spread: the replicas' standard deviation (run to run). Own error: the root mean square of the runs' "
              "standard errors. Inflation: spread / own error with its 95 % interval (chi-square); above 1 the runs' "
              "error bars are too small. Coverage: runs whose own 95 % interval (widened by sqrt(1 + 1/(n-1))) holds "
-             "the mean of the other replicas.", "",
-             "| quantity | mean | spread | own error | inflation | coverage |", "|---|---|---|---|---|---|"]
+             "the mean of the other replicas. Between beds: the spread no error bar from within one run sees, "
+             "sqrt(max(0, spread^2 - mean own error^2)). The replicas' mean is given with its 95 % interval, "
+             "t(n-1) spread / sqrt(n)."
+             + (f" Widened: the coverage with every run's 95 % interval widened to t(0.975, n_f - 1) f sem, f = "
+                f"max(1, inflation) as the {stats['widened_by']['replicas']} replicas of "
+                f"{stats['widened_by']['source']} measured it." if "widened_by" in stats else ""), "",
+             "| quantity | mean (95 %) | spread | own error | between beds | inflation | coverage |"
+             + (" factor | coverage widened |" if "widened_by" in stats else ""),
+             "|---|---|---|---|---|---|---|" + ("---|---|" if "widened_by" in stats else "")]
     for q, (label, unit, scale) in QUANTITIES.items():
         r = stats["quantities"][q]
         if r["n"] < 2:
             lines.append(f"| {label} [{unit}] | fewer than two steady replicas | | | | |")
             continue
         lo, hi = r["inflation_interval"]
-        lines.append(f"| {label} [{unit}] | {scale * r['mean']:.4g} | {scale * r['spread']:.2g} | "
-                     f"{scale * r['rms_sem']:.2g} | {r['inflation']:.2f} ({lo:.2f}–{hi:.2f}) | "
-                     f"{r['covered']} of {r['coverage_runs']} |")
+        widened = (f" {r['factor']:.2f} | {r['covered_widened']} of {r['coverage_runs']} |"
+                   if "factor" in r else "")
+        lines.append(f"| {label} [{unit}] | {scale * r['mean']:.4g} ± {scale * r['mean_ci95']:.2g} | "
+                     f"{scale * r['spread']:.2g} | {scale * r['rms_sem']:.2g} | {scale * r['between_beds']:.2g} | "
+                     f"{r['inflation']:.2f} ({lo:.2f}–{hi:.2f}) | {r['covered']} of {r['coverage_runs']} |"
+                     + widened)
     return "\n".join(lines) + "\n"

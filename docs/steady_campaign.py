@@ -205,6 +205,9 @@ def report(rows: list[dict], seeds: int, seconds: float) -> str:
         lines.append(f"| {r['scenario']} | {r['detector']} | {pct(r['steady'])} | {r['stop_median']:.2f} | {r['pitches_median']:.0f} | "
                      f"{100 * r['value_error_p95']:.1f} % | {r['zero_error_p95']:.0f} N | {pct(r['cover_value'])} | {pct(r['cover_zero'])} | "
                      f"{pct(r['cover_value_t'])} / {pct(r['cover_zero_t'])} | {r['dof_median']:.1f} | {r['noise_ratio']:.2f} | {pct(r['zero_flag'])} |")
+    lines += ["", "These synthetic runs have independent pitch means on one bed. Real runs on other beds (other particle "
+              "seeds) spread more than a run's own error bar says: see [replicas.md](replicas.md) for the measured "
+              "spread, the factor that widens a single run's interval, and how often the widened interval holds."]
     return "\n".join(lines) + "\n"
 
 

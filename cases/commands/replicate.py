@@ -22,11 +22,14 @@ def add_parser(sub) -> None:
     p.add_argument("--out", type=Path, default=None, help="replica folder (default wheelsoil-output/replicas/<case>)")
     common.add_pool_options(p, "replica", 1, "replicas run at once (default 1)")
     p.add_argument("--report-only", action="store_true", help="only rewrite the report from the finished replicas")
+    p.add_argument("--widen-by", type=Path, default=None, metavar="REPLICAS_JSON",
+                   help="also check the runs' 95 %% intervals widened to t(n_f - 1) f sem, with f = max(1, inflation) "
+                        "as another replica set of n_f runs measured it (its replicas.json)")
     p.set_defaults(func=cmd)
 
 
 def cmd(args) -> int:
-    from ..replicas import make_replicas, write_report
+    from ..replicas import Widening, make_replicas, write_report
     from ..schema import load_case
     from ..sweep import run_sweep
 
@@ -35,10 +38,12 @@ def cmd(args) -> int:
     common.check_workers_and_timeout(args.workers, args.timeout)
     out = args.out or Path("wheelsoil-output") / "replicas" / case.name
     sweep = make_replicas(case, args.seeds, out)
+    if args.widen_by is not None:
+        Widening.read(args.widen_by)  # a bad file is refused before any run
     if not args.report_only:
         run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
-    paths = write_report(sweep, case)
+    paths = write_report(sweep, case, args.widen_by)
     console.print(paths[1].read_text())
     console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")
     return common.EXIT_OK
