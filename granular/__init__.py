@@ -33,7 +33,7 @@ from .timestep import TimeStepEstimate, estimate_time_step
 #: The engine's names, imported on first use (PEP 562) so that the plain descriptions above (a bed's spec, the
 #: materials, the time step) load without Taichi: a case file is checked before the engine starts.
 _ENGINE = {"Bed": ".bed", "BedNotSettledError": ".bed", "load_bed": ".bed", "prepare_bed": ".bed", "init": ".runtime",
-           "DeviceState": ".scene", "Interaction": ".scene", "Scene": ".scene", "Wall": ".scene"}
+           "DeviceState": ".scene", "Interaction": ".interaction", "Scene": ".scene", "Wall": ".scene"}
 
 
 def __getattr__(name: str):

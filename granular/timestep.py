@@ -61,6 +61,15 @@ class TimeStepEstimate:
             f"{self.impact_speed:g} m/s / {self.steps_per_contact:g} steps)"
         )
 
+    def checked(self, dt: float) -> float:
+        """``dt`` [s] as a float, refused with the numbers unless finite, > 0 and at most the stable step."""
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt > 0):
+            raise WheelsoilInputError(f"time step {dt!r} s must be a finite number > 0")
+        if dt > self.stable * (1.0 + 1e-12):
+            raise WheelsoilInputError(f"time step {dt:.3e} s exceeds the stable time step: {self.describe()}")
+        return dt
+
 
 def estimate_time_step(
     r_min: float,

@@ -63,3 +63,19 @@ def test_engine_names_load_on_first_use():
     assert "prepare_bed" in granular.__all__ and callable(granular.prepare_bed)
     with pytest.raises(AttributeError, match="no attribute 'not_a_name'"):
         granular.not_a_name  # noqa: B018
+
+
+def test_scene_plain_parts_load_without_taichi():
+    """The scene's box, input checks and checkpoint are plain NumPy (issue 38 item 5)."""
+    done = _run("""
+        import numpy as np
+        from wheelsoil.granular.scene_checkpoint import SceneCheckpoint
+        from wheelsoil.granular.scene_domain import SceneDomain
+        from wheelsoil.granular.scene_input import checked_spheres
+        x, r, v, w = checked_spheres([[0.5, 0.5, 0.5]], 0.01)
+        assert SceneDomain.of((0, 0, 0), (1, 1, 1)).outside(x).size == 0
+        assert "taichi" not in sys.modules
+        print("plain")
+    """)
+    assert done.returncode == 0, done.stderr
+    assert "plain" in done.stdout

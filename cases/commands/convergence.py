@@ -77,6 +77,6 @@ def cmd(args) -> int:
                   console=console)
         write_report(study)
         paths = [out / n for n in ("convergence.md", "convergence.csv", "convergence.json", "convergence.png")]
-    console.print((out / "convergence.md").read_text() if (out / "convergence.md").is_file() else "")
+    console.print((out / "convergence.md").read_text() if (out / "convergence.md").is_file() else "", markup=False)
     console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")
     return common.EXIT_OK

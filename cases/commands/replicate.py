@@ -44,6 +44,6 @@ def cmd(args) -> int:
         run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
     paths = write_report(sweep, case, args.widen_by)
-    console.print(paths[1].read_text())
+    console.print(paths[1].read_text(), markup=False)  # "[mm]" is a unit, not markup
     console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")
     return common.EXIT_OK
