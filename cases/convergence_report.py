@@ -27,6 +27,15 @@ def relative_floors(case: CaseFile) -> dict:
             "sinkage": 0.5 * d, "tread_slip": 0.01}
 
 
+def with_excess(values: dict | None, excess: dict | None) -> dict | None:
+    """A level's values (:func:`_level_values`) with each quantity's standard error and the excess spread that
+    replicas measured (``excess``: per quantity, its units; :class:`~.replicas.ReplicaSpread`) added in quadrature:
+    the run-to-run spread one run's error bar does not see. ``None`` in, ``None`` out; no excess: unchanged."""
+    if values is None or not excess:
+        return values
+    return {**values, **{q: (values[q][0], math.hypot(values[q][1], excess.get(q, 0.0))) for q in QUANTITIES}}
+
+
 def _level_values(lv: Level) -> dict | None:
     if lv.folder is None or not (lv.folder / RESULT_NAME).is_file():
         return None
@@ -39,13 +48,13 @@ def _level_values(lv: Level) -> dict | None:
     return out
 
 
-def comparison_rows(study: ConvergenceStudy) -> list[dict]:
+def comparison_rows(study: ConvergenceStudy, excess: dict | None = None) -> list[dict]:
     """One row per factor, neighbouring pair of levels and quantity: the two means, their change, relative change
-    and its standard error, and whether both runs were steady."""
+    and its standard error (``excess``: see :func:`with_excess`), and whether both runs were steady."""
     floors = relative_floors(study.base)
     rows = []
     for factor, levels in study.levels.items():
-        values = [_level_values(lv) for lv in levels]
+        values = [with_excess(_level_values(lv), excess) for lv in levels]
         for k in range(len(levels) - 1):
             a, b = values[k], values[k + 1]
             for q in QUANTITIES:
@@ -84,16 +93,16 @@ def coarsest_converged(study: ConvergenceStudy, rows: list[dict]) -> dict:
 REFINED_TOWARDS_ZERO = ("particle_size", "time_step", "mesh")
 
 
-def extrapolation_rows(study: ConvergenceStudy) -> list[dict]:
+def extrapolation_rows(study: ConvergenceStudy, excess: dict | None = None) -> list[dict]:
     """Per refined factor (:data:`REFINED_TOWARDS_ZERO`) and quantity, :func:`extrapolate_levels` of the study's
-    levels."""
+    levels (``excess``: see :func:`with_excess`)."""
     floors = relative_floors(study.base)
     rows = []
     for factor in REFINED_TOWARDS_ZERO:
         levels = study.levels.get(factor, [])
         if len(levels) >= 2:
-            rows += extrapolate_levels(factor, [(lv.scale, _level_values(lv)) for lv in levels], floors,
-                                       study.threshold)
+            rows += extrapolate_levels(factor, [(lv.scale, with_excess(_level_values(lv), excess)) for lv in levels],
+                                       floors, study.threshold)
     return rows
 
 
@@ -134,13 +143,15 @@ def extrapolate_levels(factor: str, levels: list[tuple[float, dict | None]], flo
     return rows
 
 
-def write_report(study: ConvergenceStudy) -> list[Path]:
-    """convergence.csv, convergence.json, convergence.md and convergence.png in the study folder."""
+def write_report(study: ConvergenceStudy, replicas=None) -> list[Path]:
+    """convergence.csv, convergence.json, convergence.md and convergence.png in the study folder. ``replicas``
+    (:class:`~.replicas.ReplicaSpread`): its excess spread is added to every level's standard error."""
     import pandas as pd
 
-    rows = comparison_rows(study)
+    excess = replicas.excess if replicas is not None else None
+    rows = comparison_rows(study, excess)
     verdict = coarsest_converged(study, rows)
-    extrapolated = extrapolation_rows(study)
+    extrapolated = extrapolation_rows(study, excess)
     study.out.mkdir(parents=True, exist_ok=True)
     table = pd.DataFrame(rows)
     written = []
@@ -151,23 +162,30 @@ def write_report(study: ConvergenceStudy) -> list[Path]:
                    "values": _level_values(lv)} for lv in lvs] for f, lvs in study.levels.items()}
     with atomic_output(study.out / "convergence.json") as tmp:
         tmp.write_text(json.dumps({"base": study.base.name, "threshold": study.threshold, "coarsest_converged": verdict,
-                                   "levels": levels, "comparisons": rows, "extrapolated": extrapolated}, indent=2,
-                                  default=float))
+                                   "levels": levels, "comparisons": rows, "extrapolated": extrapolated,
+                                   "excess_spread": None if replicas is None else
+                                   {"source": replicas.source, "replicas": replicas.replicas, "excess": excess}},
+                                  indent=2, default=float))
     written.append(study.out / "convergence.json")
     with atomic_output(study.out / "convergence.md") as tmp:
-        tmp.write_text(report_markdown(study, rows, verdict, levels, extrapolated))
+        tmp.write_text(report_markdown(study, rows, verdict, levels, extrapolated, replicas))
     written.append(study.out / "convergence.md")
     written.append(_plot(study, rows))
     return written
 
 
 def report_markdown(study: ConvergenceStudy, rows: list[dict], verdict: dict, levels: dict,
-                    extrapolated: list[dict] | None = None) -> str:
+                    extrapolated: list[dict] | None = None, replicas=None) -> str:
     pct = int(round(100 * study.threshold))
+    spread = ("" if replicas is None else
+              f" Every level's standard error has the run-to-run excess spread that the {replicas.replicas} replicas "
+              f"of {replicas.source} measured added in quadrature ("
+              + ", ".join(f"{QUANTITIES[q][0]} {QUANTITIES[q][2] * x:.2g} {QUANTITIES[q][1]}"
+                          for q, x in replicas.excess.items()) + "); the Levels table shows each run's own.")
     lines = [f"# Convergence study: {study.base.name}", "",
              f"Each factor's levels against the reference; a change is the finer level's mean minus the coarser's, "
              f"relative to the finer mean (or the floor), ± one standard error (batch means over whole pitches). "
-             f"Converged: every quantity changes by less than {pct} % and both runs were steady.", "",
+             f"Converged: every quantity changes by less than {pct} % and both runs were steady." + spread, "",
              "## Levels", "", "| factor | scale | changes | particles | DEM step [s] | steady | wall [s] | "
              + " | ".join(f"{v[0]} [{v[1]}]" for v in QUANTITIES.values()) + " |",
              "|" + "---|" * (7 + len(QUANTITIES))]

@@ -13,10 +13,13 @@ on one bed per seed (a sweep over ``case.seed``: finished replicas are kept) and
 * the **coverage**: how many runs' own 95 % intervals (``ci95``, Student's t) hold the mean of the other replicas,
   with the interval widened by sqrt(1 + 1 / (n - 1)) for that mean's own scatter; an honest interval holds it in
   about 95 % of runs;
-* the spread **between beds**, sigma_b = sqrt(max(0, s^2 - mean(sem^2))): the part of the spread that no error bar
-  from within one run can see (a one-way random-effects model, method of moments), and the **replicas' mean with its
-  95 % interval**, t(0.975, n - 1) s / sqrt(n): the error bar the replicas give a number;
-* with factors from another replica set of n_f runs (``--widen-by REPLICAS_JSON``, :class:`Widening`: per quantity
+* the **excess spread** sigma_x = sqrt(max(0, s^2 - mean(sem^2))): the part of the run-to-run spread that no error
+  bar from within one run sees (a one-way random-effects model, method of moments). It holds the packing's share
+  (another seed, another bed) and the trajectory's (the same bed run again diverges from round-off on: the smoke
+  case's reruns at later commits scatter as much as its seeds); it is added in quadrature to each level's error by
+  ``wheelsoil convergence --replicas``. And the **replicas' mean with its 95 % interval**, t(0.975, n - 1) s /
+  sqrt(n): the error bar the replicas give a number;
+* with factors from another replica set of n_f runs (``--widen-by REPLICAS_JSON``, :class:`ReplicaSpread`: per quantity
   f = max(1, its inflation)), the coverage of the runs' intervals widened to t(0.975, n_f - 1) f sem: the check, on
   replicas not used to set the factors, that a widened single-run interval holds as often as it claims. Student's t
   at n_f - 1 degrees of freedom carries the factor's own scatter: f sem is an estimate of the spread from n_f runs,
@@ -82,37 +85,48 @@ def _summaries(sweep: Sweep) -> list[tuple[int, RunSummary | None]]:
 
 
 @dataclass(frozen=True)
-class Widening:
-    """Per quantity the factor f = max(1, inflation) that a replica set of ``replicas`` runs measured (1 where it
-    measured none), read from its ``replicas.json`` (``source``)."""
+class ReplicaSpread:
+    """What a replica set of ``replicas`` runs measured, read from its ``replicas.json`` (``source``): per quantity
+    the factor f = max(1, inflation) (1 where it measured none) and the excess spread sigma_x (0 where none; the
+    quantity's units)."""
 
     factors: dict[str, float]
+    excess: dict[str, float]
     replicas: int
     source: str
 
     @classmethod
-    def read(cls, path: str | Path) -> "Widening":
+    def read(cls, path: str | Path, option: str = "--widen-by") -> "ReplicaSpread":
         path = Path(path)
         try:
             stats = json.loads(path.read_text())
             quantities, replicas = stats["quantities"], len(stats["steady"])
         except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise WheelsoilInputError(f"--widen-by {path}: not a replicas.json written by 'wheelsoil replicate' "
+            raise WheelsoilInputError(f"{option} {path}: not a replicas.json written by 'wheelsoil replicate' "
                                       f"({type(exc).__name__}: {exc})") from None
         if replicas < 2:
-            raise WheelsoilInputError(f"--widen-by {path}: {replicas} steady replicas; a factor needs at least two")
-        factors = {}
+            raise WheelsoilInputError(f"{option} {path}: {replicas} steady replicas; a spread needs at least two")
+        factors, excess = {}, {}
         for q in QUANTITIES:
-            f = quantities.get(q, {}).get("inflation", math.nan)
-            factors[q] = max(1.0, float(f)) if f is not None and math.isfinite(float(f)) else 1.0
-        return cls(factors, replicas, str(path))
+            f = _finite(quantities.get(q, {}).get("inflation"))
+            factors[q] = max(1.0, f) if f is not None else 1.0
+            excess[q] = _finite(quantities.get(q, {}).get("excess_spread")) or 0.0
+        return cls(factors, excess, replicas, str(path))
 
     def half_width(self, quantity: str, sem):
         """The widened 95 % half-width t(0.975, n_f - 1) f sem (units of ``sem``)."""
         return float(student_t.ppf(0.975, self.replicas - 1)) * self.factors[quantity] * np.asarray(sem, float)
 
 
-def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening: Widening | None = None) -> dict:
+def _finite(value) -> float | None:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) else None
+
+
+def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening: ReplicaSpread | None = None) -> dict:
     """The replicas' statistics (see the module docstring) from (seed, summary or None) pairs; ``widening``: the
     factors of another replica set whose widened intervals to check."""
     done = [(s, m) for s, m in summaries if m is not None]
@@ -133,8 +147,8 @@ def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening:
                        inflation=sd / rms if rms > 0 else math.nan,
                        inflation_interval=[sd * math.sqrt((n - 1) / lo) / rms, sd * math.sqrt((n - 1) / hi) / rms]
                        if rms > 0 else [math.nan, math.nan])
-            between = math.sqrt(max(0.0, sd * sd - float(np.mean(sem ** 2)))) if math.isfinite(rms) else math.nan
-            row.update(between_beds=between, mean_ci95=float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n))
+            excess = math.sqrt(max(0.0, sd * sd - float(np.mean(sem ** 2)))) if math.isfinite(rms) else math.nan
+            row.update(excess_spread=excess, mean_ci95=float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n))
             others = np.array([(x.sum() - x[k]) / (n - 1) for k in range(n)])
             reach = np.abs(x - others) / math.sqrt(1.0 + 1.0 / (n - 1))
             known = np.isfinite(ci)
@@ -148,7 +162,7 @@ def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening:
 
 def write_report(sweep: Sweep, base: CaseFile, widen_by: str | Path | None = None) -> list[Path]:
     """replicas.json and replicas.md in the sweep folder (``widen_by``: a replicas.json whose factors to check)."""
-    widening = Widening.read(widen_by) if widen_by is not None else None
+    widening = ReplicaSpread.read(widen_by) if widen_by is not None else None
     stats = replica_statistics(_summaries(sweep), widening)
     if widening is not None:
         stats["widened_by"] = {"source": widening.source, "replicas": widening.replicas, "factors": widening.factors}
@@ -169,13 +183,13 @@ def report_markdown(name: str, stats: dict) -> str:
              "Spread: the replicas' standard deviation (run to run). Own error: the root mean square of the runs' "
              "standard errors. Inflation: spread / own error with its 95 % interval (chi-square); above 1 the runs' "
              "error bars are too small. Coverage: runs whose own 95 % interval (widened by sqrt(1 + 1/(n-1))) holds "
-             "the mean of the other replicas. Between beds: the spread no error bar from within one run sees, "
+             "the mean of the other replicas. Excess: the spread no error bar from within one run sees, "
              "sqrt(max(0, spread^2 - mean own error^2)). The replicas' mean is given with its 95 % interval, "
              "t(n-1) spread / sqrt(n)."
              + (f" Widened: the coverage with every run's 95 % interval widened to t(0.975, n_f - 1) f sem, f = "
                 f"max(1, inflation) as the {stats['widened_by']['replicas']} replicas of "
                 f"{stats['widened_by']['source']} measured it." if "widened_by" in stats else ""), "",
-             "| quantity | mean (95 %) | spread | own error | between beds | inflation | coverage |"
+             "| quantity | mean (95 %) | spread | own error | excess | inflation | coverage |"
              + (" factor | coverage widened |" if "widened_by" in stats else ""),
              "|---|---|---|---|---|---|---|" + ("---|---|" if "widened_by" in stats else "")]
     for q, (label, unit, scale) in QUANTITIES.items():
@@ -187,7 +201,7 @@ def report_markdown(name: str, stats: dict) -> str:
         widened = (f" {r['factor']:.2f} | {r['covered_widened']} of {r['coverage_runs']} |"
                    if "factor" in r else "")
         lines.append(f"| {label} [{unit}] | {scale * r['mean']:.4g} ± {scale * r['mean_ci95']:.2g} | "
-                     f"{scale * r['spread']:.2g} | {scale * r['rms_sem']:.2g} | {scale * r['between_beds']:.2g} | "
+                     f"{scale * r['spread']:.2g} | {scale * r['rms_sem']:.2g} | {scale * r['excess_spread']:.2g} | "
                      f"{r['inflation']:.2f} ({lo:.2f}–{hi:.2f}) | {r['covered']} of {r['coverage_runs']} |"
                      + widened)
     return "\n".join(lines) + "\n"

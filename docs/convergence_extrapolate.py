@@ -5,6 +5,10 @@ extrapolated to scale 0 from the levels' stored means and standard errors, no ru
 Usage (from the repository root)::
 
     python docs/convergence_extrapolate.py docs/convergence/smoke-1g-steer/convergence.json [--case smoke-1g-steer]
+        [--replicas RUNS/replicas/smoke-1g-steer/replicas.json]
+
+``--replicas``: every level's standard error gets the run-to-run excess spread those replicas measured added in
+quadrature (:func:`wheelsoil.cases.convergence_report.with_excess`).
 
 Prints a Markdown table: per factor and quantity the extrapolated value +- its standard error, the reference's
 error against it (relative, +- one standard error) and whether that error plus two standard errors is within the
@@ -26,7 +30,10 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("study_json")
     parser.add_argument("--case", default=None, help="the study's base case (default: the JSON's 'base')")
+    parser.add_argument("--replicas", default=None, help="a replicas.json whose excess spread to add to every level")
     args = parser.parse_args(argv)
+    from wheelsoil.cases.replicas import ReplicaSpread
+    excess = ReplicaSpread.read(args.replicas, "--replicas").excess if args.replicas else None
     study = json.loads(open(args.study_json).read())
     case = load_case(args.case or study["base"])
     floors = report.relative_floors(case)
@@ -38,8 +45,8 @@ def main(argv=None) -> int:
         levels = study["levels"].get(factor)
         if not levels or len(levels) < 2:
             continue
-        pairs = [(lv["scale"], None if lv["values"] is None else
-                  {**lv["values"], **{q: tuple(lv["values"][q]) for q in cv.QUANTITIES}}) for lv in levels]
+        pairs = [(lv["scale"], report.with_excess(None if lv["values"] is None else
+                  {**lv["values"], **{q: tuple(lv["values"][q]) for q in cv.QUANTITIES}}, excess)) for lv in levels]
         for row in report.extrapolate_levels(factor, pairs, floors, threshold):
             label, unit, scale = cv.QUANTITIES[row["quantity"]]
             scales = ", ".join(f"{s:g}" for s, _ in pairs)

@@ -195,3 +195,52 @@ def test_a_linear_series_extrapolates_to_its_intercept_and_the_verdict_follows_i
     assert "## Extrapolated to zero scale" in text
     assert ("particle_size: converged: extrapolated" in text) is converged
     assert ("particle_size: **not converged**: extrapolated" in text) is not converged
+
+
+def test_replicas_excess_spread_widens_every_levels_error(mini, tmp_path, monkeypatch):
+    """The same linear series with 1 % errors (slope 0.02: converged on its own errors) is not converged once the
+    replicas' excess spread (here 10 % of each value) is added in quadrature to every level: the errors, and so the
+    extrapolation's, grow as the quadrature sum says; the means do not move."""
+    from wheelsoil.cases.replicas import ReplicaSpread
+
+    base = {"drawbar_pull": 500.0, "lateral_force": -200.0, "vertical_force": 3000.0, "torque": 600.0,
+            "sinkage": 0.08, "tread_slip": 0.3}
+
+    def values(lv):
+        out = {"steady": True, "wall_seconds": 1.0, "particles": 1, "dem_time_step": 1e-5}
+        for q, v in base.items():
+            m = v * (1 + 0.02 * lv.scale)
+            out[q] = (m, 0.01 * abs(m))
+        return out
+
+    study = cv.make_study(mini, tmp_path, {"particle_size": (1, 0.8, 0.64)})
+    monkeypatch.setattr(cr, "_level_values", values)
+    excess = {q: 0.1 * abs(v) for q, v in base.items()}
+    plain = {r["quantity"]: r for r in cr.extrapolation_rows(study)}
+    wide = {r["quantity"]: r for r in cr.extrapolation_rows(study, excess)}
+    for q in base:
+        assert wide[q]["value"] == pytest.approx(plain[q]["value"], rel=1e-9)
+        assert plain[q]["converged"] and not wide[q]["converged"]
+        assert wide[q]["value_se"] > 5 * plain[q]["value_se"]
+    one = values(study.levels["particle_size"][0])
+    widened = cr.with_excess(one, excess)
+    assert widened["drawbar_pull"] == (one["drawbar_pull"][0], pytest.approx(math.hypot(0.01 * 510.0, 50.0)))
+    assert cr.with_excess(one, None) is one and cr.with_excess(None, excess) is None
+    rows = cr.comparison_rows(study, excess)
+    r = next(r for r in rows if r["coarse_scale"] == 1.0 and r["quantity"] == "torque")
+    assert r["change_sem"] == pytest.approx(math.hypot(math.hypot(0.01 * 612.0, 60.0), math.hypot(0.01 * 609.6, 60.0)))
+    spread = ReplicaSpread({q: 1.0 for q in base}, excess, 5, "replicas.json")
+    cr.write_report(study, spread)
+    text = (tmp_path / "convergence.md").read_text()
+    assert "excess spread that the 5 replicas of replicas.json measured added in quadrature" in text
+
+
+def test_a_bad_replicas_file_is_refused_before_any_work(tmp_path, capsys):
+    from wheelsoil.cases.cli import EXIT_INPUT, main
+
+    bad = tmp_path / "replicas.json"
+    bad.write_text("{}")
+    assert main(["convergence", "mini-1g-steer", "--out", str(tmp_path / "c"), "--replicas", str(bad)]) == EXIT_INPUT
+    err = capsys.readouterr().err
+    assert "--replicas" in err and "not a replicas.json" in err and "Traceback" not in err
+    assert not (tmp_path / "c").exists()

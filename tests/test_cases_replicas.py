@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from wheelsoil.cases.replicas import (QUANTITIES, check_seeds, make_replicas, replica_statistics, report_markdown,
-                                     Widening)
+                                     ReplicaSpread)
 from wheelsoil.cases.schema import load_case
 from wheelsoil.coupling.run_summary import QuantityStats, RunSummary
 from wheelsoil.errors import WheelsoilInputError
@@ -109,13 +109,13 @@ def test_factors_set_on_one_replica_set_restore_coverage_on_another(seed, tmp_pa
         first = replica_statistics(_campaign(rng, 5, 2.0, 2.0 / 3.0))
         path = tmp_path / "replicas.json"
         path.write_text(json.dumps(first))
-        widening = Widening.read(path)
+        widening = ReplicaSpread.read(path)
         factors.append(widening.factors["drawbar_pull"])
         r = replica_statistics(_campaign(rng, 5, 2.0, 2.0 / 3.0), widening)["quantities"]["drawbar_pull"]
         covered += r["covered"]
         widened += r["covered_widened"]
         runs += r["coverage_runs"]
-        between.append(r["between_beds"] ** 2)
+        between.append(r["excess_spread"] ** 2)
     assert covered / runs < 0.6
     # Student's t at 4 dof carries the factor's own scatter: the widened intervals hold about 95 % of the time (a
     # normal 1.96 f sem would hold 88 %: P(|T_4| < 1.96))
@@ -130,7 +130,8 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
     from scipy.stats import t as student_t
 
     rng = np.random.default_rng(5)
-    stats = replica_statistics(_campaign(rng, 4, 1.0, 0.5), Widening({q: 2.0 for q in QUANTITIES}, 5, "x"))
+    stats = replica_statistics(_campaign(rng, 4, 1.0, 0.5), ReplicaSpread({q: 2.0 for q in QUANTITIES},
+                                                                          {q: 0.0 for q in QUANTITIES}, 5, "x"))
     r = stats["quantities"]["sinkage"]
     assert r["mean_ci95"] == pytest.approx(student_t.ppf(0.975, 3) * r["spread"] / 2.0)
     assert r["covered"] <= r["covered_widened"] <= r["coverage_runs"] == 4
@@ -140,17 +141,19 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{}")
     with pytest.raises(WheelsoilInputError, match=r"--widen-by .*bad.json: not a replicas.json"):
-        Widening.read(bad)
+        ReplicaSpread.read(bad)
     with pytest.raises(WheelsoilInputError, match="not a replicas.json"):
-        Widening.read(tmp_path / "missing.json")
+        ReplicaSpread.read(tmp_path / "missing.json")
     ok = tmp_path / "ok.json"
-    ok.write_text(json.dumps({"steady": [0, 1, 2], "quantities": {"drawbar_pull": {"inflation": 2.5},
-                                                                   "torque": {"inflation": 0.4}}}))
-    widening = Widening.read(ok)
+    quantities = {"drawbar_pull": {"inflation": 2.5, "excess_spread": 3.0},
+                  "torque": {"inflation": 0.4, "excess_spread": None}}
+    ok.write_text(json.dumps({"steady": [0, 1, 2], "quantities": quantities}))
+    widening = ReplicaSpread.read(ok)
     assert widening.factors["drawbar_pull"] == 2.5 and widening.factors["torque"] == 1.0
+    assert widening.excess["drawbar_pull"] == 3.0 and widening.excess["torque"] == 0.0
     assert widening.factors["sinkage"] == 1.0 and widening.replicas == 3
     assert widening.half_width("drawbar_pull", 1.0) == pytest.approx(student_t.ppf(0.975, 2) * 2.5)
     one = tmp_path / "one.json"
     one.write_text(json.dumps({"steady": [0], "quantities": {}}))
-    with pytest.raises(WheelsoilInputError, match="1 steady replicas; a factor needs at least two"):
-        Widening.read(one)
+    with pytest.raises(WheelsoilInputError, match="1 steady replicas; a spread needs at least two"):
+        ReplicaSpread.read(one)

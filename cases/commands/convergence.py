@@ -41,12 +41,16 @@ def add_parser(sub) -> None:
                    help="DEM step of the particle-size levels: 'common' (default), all at the finest level's, so the "
                         "series changes the particles alone; 'own', each at its own stable step (studies before "
                         "2026-11-26)")
+    p.add_argument("--replicas", type=Path, default=None, metavar="REPLICAS_JSON",
+                   help="add the run-to-run excess spread that replicas of the case measured ('wheelsoil replicate': "
+                        "its replicas.json) to every level's standard error")
     p.set_defaults(func=cmd)
 
 
 def cmd(args) -> int:
     from ..convergence import DEFAULT_LEVELS, make_study, parse_levels, plan, resolve_time_step_levels, run_study
     from ..convergence_report import write_report
+    from ..replicas import ReplicaSpread
     from ..schema import load_case
 
     console = common.console()
@@ -60,10 +64,11 @@ def cmd(args) -> int:
     out = args.out or Path("wheelsoil-output") / "convergence" / case.name
     if args.level_drive_time is not None and not args.level_drive_time > 0:
         raise common.InputError(f"--level-drive-time {args.level_drive_time} must be > 0 seconds")
+    replicas = ReplicaSpread.read(args.replicas, "--replicas") if args.replicas is not None else None
     study = make_study(case, out, levels, args.threshold, level_drive_time=args.level_drive_time,
                        particle_step=args.particle_step)
     if args.report_only:
-        paths = write_report(study)
+        paths = write_report(study, replicas)
     else:
         resolve_time_step_levels(study)  # with the others when the reference has already run
         console.print(f"convergence study of {case.name}: {len(study.cases())} cases "
@@ -75,7 +80,7 @@ def cmd(args) -> int:
                           f"soil cost x {row['relative_soil_cost']:.2g}, drive up to {row['drive_time']:g} s")
         run_study(study, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
-        write_report(study)
+        write_report(study, replicas)
         paths = [out / n for n in ("convergence.md", "convergence.csv", "convergence.json", "convergence.png")]
     console.print((out / "convergence.md").read_text() if (out / "convergence.md").is_file() else "", markup=False)
     console.print(f"wrote {', '.join(p.name for p in paths)} in {out}")

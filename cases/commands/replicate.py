@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
 
 
 def cmd(args) -> int:
-    from ..replicas import Widening, make_replicas, write_report
+    from ..replicas import ReplicaSpread, make_replicas, write_report
     from ..schema import load_case
     from ..sweep import run_sweep
 
@@ -39,7 +39,7 @@ def cmd(args) -> int:
     out = args.out or Path("wheelsoil-output") / "replicas" / case.name
     sweep = make_replicas(case, args.seeds, out)
     if args.widen_by is not None:
-        Widening.read(args.widen_by)  # a bad file is refused before any run
+        ReplicaSpread.read(args.widen_by)  # a bad file is refused before any run
     if not args.report_only:
         run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
