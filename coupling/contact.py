@@ -61,11 +61,11 @@ from wheelsoil.granular.materials import (
 from wheelsoil.granular.contact import ROLLING_MODELS
 from wheelsoil.granular.scene import Interaction, Scene
 from wheelsoil.granular.neighbors import exclusive_scan
-from wheelsoil.taichi_types import ivec3, vec3
-from wheelsoil.taichi_types import to_ndarray as _nd
+from wheelsoil.taichi_types import vec3
 
 from . import kernels as k
 from .surface import ContactSurface
+from .surface_arrays import SurfaceArrays
 
 #: Physical contacts per sphere whose tangential history is kept (a sphere touches the wheel at one
 #: or two places in practice: a face, or the corner between the tread and a grouser).
@@ -132,20 +132,7 @@ class WheelContact(Interaction):
         self._steps = 0
         self._n_contacts = 0
         sf = self.surface
-        self._tri = _nd(ti.i32, sf.triangles.astype(np.int32))
-        self._edges = _nd(ti.i32, sf.edges.astype(np.int32))
-        self._half_t = _nd(ti.f64, sf.half_thickness)
-        self._nodes = _nd(ti.i32, sf.nodes.astype(np.int32))
-        self._corner_start = _nd(ti.i32, sf.corner_start.astype(np.int32))
-        self._corners = _nd(ti.i32, sf.corners.astype(np.int32))
-        free = np.ones(structure.mesh.n_nodes, bool)
-        free[structure.hub_nodes] = False
-        self._inv_mass = _nd(ti.f64, np.where(free & (structure.mass > 0), 1.0 / np.maximum(structure.mass, 1e-300), 0.0))
-        self._node_ref = ti.Vector.ndarray(3, ti.f64, shape=len(sf.nodes))
-        self._lo = ti.ndarray(ivec3, shape=sf.n_facets)
-        self._hi = ti.ndarray(ivec3, shape=sf.n_facets)
-        self._facet_start = ti.ndarray(ti.i32, shape=sf.n_facets + 1)
-        self._facet_fill = ti.ndarray(ti.i32, shape=sf.n_facets)
+        self._surface_arrays = SurfaceArrays.upload(sf, structure)
         self._resultant = ti.Vector.ndarray(3, ti.f64, shape=5)
         self._resultant.fill(0.0)
         self._stats = ti.ndarray(ti.f64, shape=2)
@@ -193,7 +180,7 @@ class WheelContact(Interaction):
         ds = self._scene_state = scene.device_state()
         self._contact_arrays = None
         w = self.structure.device_arrays()
-        a = self._arrays
+        a, d = self._arrays, self._surface_arrays
         sf = self.surface
         # the soil's own grid (:meth:`Scene.grid`): a facet is binned into every cell its box grown by r_max + skin
         # meets, and a sphere reads only its cell, so any cell edge works
@@ -203,27 +190,27 @@ class WheelContact(Interaction):
             a["cell_start"] = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
         origin, inv_cell, dims = grid.kernel_args()
         pad = self.r_max + self.skin
-        k.facet_cell_ranges(w.x, self._tri, self._half_t, sf.n_facets, pad, origin, inv_cell, dims,
-                            self._lo, self._hi, a["cell_count"])
+        k.facet_cell_ranges(w.x, d.triangles, d.half_thickness, sf.n_facets, pad, origin, inv_cell, dims,
+                            d.facet_lo, d.facet_hi, a["cell_count"])
         total = exclusive_scan(a["cell_count"], a["cell_start"])
         cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
         cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
-        k.fill_facet_cells(sf.n_facets, dims, self._lo, self._hi, a["cell_start"], cell_fill, cell_facets)
+        k.fill_facet_cells(sf.n_facets, dims, d.facet_lo, d.facet_hi, a["cell_start"], cell_fill, cell_facets)
         k.count_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
-                           w.x, self._tri, self._half_t, a["count"], a["hist_count"])
+                           w.x, d.triangles, d.half_thickness, a["count"], a["hist_count"])
         n_cand = exclusive_scan(a["count"], a["start"])
         cand = self._buffer("cand", ti.i32, max(n_cand, 1))
         k.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
-                          w.x, self._tri, self._half_t, a["start"], cand)
+                          w.x, d.triangles, d.half_thickness, a["start"], cand)
         facet_entries = self._buffer("facet_entries", ti.i32, max(n_cand, 1))
-        self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, self._facet_start,
-                                        self._facet_fill, facet_entries)
+        self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, d.facet_start,
+                                        d.facet_fill, facet_entries)
         for name, dtype in (("code", ti.i32), ("keep", ti.i32), ("overlap", ti.f64), ("stiffness", ti.f64), ("normal", vec3),
                             ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3), ("roll_new", vec3)):
             self._buffer(name, dtype, max(n_cand, 1))
         self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
         self._arrays["keep"].fill(0)
-        k.copy_node_positions(w.x, self._nodes, self._node_ref)
+        k.copy_node_positions(w.x, d.nodes, d.node_reference)
         self._seen_rebuilds = scene.neighbor_rebuilds
         self._need_rebuild = False
         self.rebuilds += 1
@@ -256,15 +243,15 @@ class WheelContact(Interaction):
         if self._contact_arrays is None:
             ds = self._scene_state
             w = self.structure.device_arrays()
-            a = self._arrays
+            a, d = self._arrays, self._surface_arrays
             self._contact_arrays = (
                 (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
                 (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
                  a["f_wheel"], a["m_wheel"], a["xi_new"], a["roll_new"], a["stiffness"], a["hist_n"], a["hist_xi"],
                  a["hist_roll"], a["hist_count"],
-                 w.x, w.v, w.w, self._inv_mass, self._tri, self._edges, self._half_t,
-                 self._nodes, self._corner_start, self._corners, self._facet_start, a["facet_entries"],
-                 w.f_ext, w.k_ext, w.x_anchor, self._node_ref, w.hub, self._resultant),
+                 w.x, w.v, w.w, d.inverse_mass, d.triangles, d.edges, d.half_thickness,
+                 d.nodes, d.corner_start, d.corners, d.facet_start, a["facet_entries"],
+                 w.f_ext, w.k_ext, w.x_anchor, d.node_reference, w.hub, self._resultant),
             )
         particles, rest = self._contact_arrays
         k.wheel_contacts_graph(

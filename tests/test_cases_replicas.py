@@ -157,3 +157,13 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
     one.write_text(json.dumps({"steady": [0], "quantities": {}}))
     with pytest.raises(WheelsoilInputError, match="1 steady replicas; a spread needs at least two"):
         ReplicaSpread.read(one)
+
+
+def test_a_steady_run_says_its_intervals_are_within_the_run():
+    from wheelsoil.cases.commands.run import summary_lines
+
+    rng = np.random.default_rng(0)
+    steady = _campaign(rng, 1, 1.0, 1.0)[0][1]
+    assert any("wheelsoil replicate" in line for line in summary_lines(steady))
+    unsteady = _campaign(rng, 1, 1.0, 1.0, steady=False)[0][1]
+    assert not any("wheelsoil replicate" in line for line in summary_lines(unsteady))

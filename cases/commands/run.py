@@ -81,6 +81,10 @@ def summary_lines(s: RunSummary) -> list[str]:
     lines.append(f"  {'tread slip':16s} {s.tread_slip.mean:10.4f}      (commanded {s.commanded_slip:g}; "
                  f"tread slip angle {s.tread_slip_angle.mean:.2f} deg, commanded "
                  f"{s.commanded_slip_angle:g}; wind-up {s.wind_up.mean:.3f} rad)")
+    if s.steady:
+        lines.append("  (the intervals see the noise within this run; runs on other seeds scatter more: drawbar pull "
+                     "and torque about twice as much in the smoke case. 'wheelsoil replicate' measures it: "
+                     "docs/replicas.md)")
     for reason in s.reasons:
         lines.append(f"  [yellow]not steady:[/] {reason}")
     return lines
