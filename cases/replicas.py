@@ -154,8 +154,10 @@ def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening:
             known = np.isfinite(ci)
             row.update(covered=int(np.sum((reach <= ci) & known)), coverage_runs=int(known.sum()))
             if widening is not None:
-                row.update(factor=widening.factors[q],
-                           covered_widened=int(np.sum((reach <= widening.half_width(q, sem)) & known)))
+                # never narrower than the run's own interval (a factor of 1 at n_f - 1 dof above the run's own
+                # would otherwise narrow it)
+                widened = np.maximum(ci, widening.half_width(q, sem))
+                row.update(factor=widening.factors[q], covered_widened=int(np.sum((reach <= widened) & known)))
         result["quantities"][q] = row
     return result
 

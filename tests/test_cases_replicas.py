@@ -3,6 +3,7 @@ synthetic campaigns with known spread (honest error bars: inflation about 1, cov
 times too small: inflation about 3, coverage far below)."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -135,6 +136,11 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
     r = stats["quantities"]["sinkage"]
     assert r["mean_ci95"] == pytest.approx(student_t.ppf(0.975, 3) * r["spread"] / 2.0)
     assert r["covered"] <= r["covered_widened"] <= r["coverage_runs"] == 4
+    # a factor of 1 from many replicas (t near 1.96) never narrows a run's own wider interval
+    unit = ReplicaSpread({q: 1.0 for q in QUANTITIES}, {q: 0.0 for q in QUANTITIES}, 1000, "x")
+    wide_own = [(seed, replace(summary, **{q: replace(summary.quantity(q), ci95=100.0) for q in QUANTITIES}))
+                for seed, summary in _campaign(rng, 4, 1.0, 0.5)]
+    assert replica_statistics(wide_own, unit)["quantities"]["torque"]["covered_widened"] == 4
     stats["widened_by"] = {"source": "other/replicas.json", "replicas": 5, "factors": {}}
     text = report_markdown("mini", stats)
     assert "coverage widened" in text and "5 replicas of other/replicas.json" in text and " 2.00 | " in text
