@@ -64,7 +64,7 @@ from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed
 
 from .contact import WheelContact
-from .kinematics import TreadTracker, deformation, longitudinal_slip, rig_command, slip_angle_deg, yaw_matrix
+from .kinematics import TreadTracker, deformation, rig_command, yaw_matrix
 from .patch import MovingPatch
 from .placement import wheel_start_centre
 from .protocol import DEFAULT_PROTOCOL, advance, step_named
@@ -74,6 +74,7 @@ from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage
 from .run_progress import RunProgress
 from .run_statistics import detect_from_rows
 from .run_summary import SERIES_UNITS
+from .sample_row import sample_row
 from .steady import SteadyState
 from .testbed_result import TestbedResult, testbed_result
 
@@ -130,15 +131,16 @@ class Testbed:
         self.mesh = mesh
         tread = mesh.part_names.index("tread") if "tread" in mesh.part_names else None
         facets = mesh.triangles if tread is None else mesh.triangles[mesh.part[: len(mesh.triangles)] == tread]
-        self._tread_nodes = np.unique(facets)
+        #: the tread's nodes (the tread part's, or every surface node of a wheel without one)
+        self.tread_nodes = np.unique(facets)
         self.structure = Structure(mesh, hub_nodes=hub_nodes, hub_center=center, hub_mass=wheel.hub_mass,
                                    rigid=spec.rigid, damping=spec.damping, gravity=bs.gravity, arch=arch)
         self.wheel_mass = float(self.structure.mass.sum() + wheel.hub_mass)
         self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / 0.1
         self.heading = self.yaw[:, 0]
         self.axle = self.yaw[:, 1]
-        self.tracker = TreadTracker(mesh.nodes[self._tread_nodes], self.heading, self.axle,
-                                    weights=self.structure.mass[self._tread_nodes])
+        self.tracker = TreadTracker(mesh.nodes[self.tread_nodes], self.heading, self.axle,
+                                    weights=self.structure.mass[self.tread_nodes])
         self.pitch = statistics_pitch(wheel)  # the batch of the steady-state statistics [rad]
         self.period_pitches = batches_per_period(wheel)  # the wheel's whole period in batches
 
@@ -252,7 +254,7 @@ class Testbed:
             self.patch.drop_thrown_out(self.scene)
         interval = self.steps_per_sample * self.dt
         loop.hub_angle += loop.hub_spin * interval
-        row = self._measure(phase, interval)
+        row = sample_row(self, phase, interval)
         for key, val in row.items():
             rows[key].append(float(val))
         if abs(row["wind_up"]) > s.max_wind_up:
@@ -264,46 +266,6 @@ class Testbed:
         if self.patch is not None and phase != "lower":
             loop.shift += self.patch.update(self)
         return advance(self.protocol, self, loop, row, self.scene.time)
-
-    def _measure(self, phase: str, interval: float) -> dict:
-        s, loop = self.spec, self._loop
-        force, moment, _ = self.contact.mean_resultant(reset=True)
-        hub = self.structure.hub_position
-        vel = self.structure.hub_velocity
-        spin = float(self.structure.hub_angular_velocity @ self.axle)
-        nodes = self.structure.positions()
-        tread = self.tracker.state(nodes[self._tread_nodes], self.structure.hub_rotation)
-        tread_angle = loop.hub_angle - tread.wind_up
-        previous = tread_angle if loop.tread_angle is None else loop.tread_angle
-        loop.tread_angle = tread_angle
-        tread_omega = (tread_angle - previous) / interval
-        loop.omega_filtered += (tread_omega - loop.omega_filtered) * min(1.0, interval / s.windup_filter)
-        vx = float(vel @ self.heading)
-        vx_tread = float(vel @ tread.heading)
-        if self.spec.slip_speed == "travel":  # the whole horizontal travel speed, the same for hub and tread
-            vx = vx_tread = float(math.hypot(vel[0], vel[1]))
-        r = self.wheel.radius
-        return {
-            "t": self.scene.time,
-            "drawbar_pull": force @ self.heading,
-            "lateral_force": force @ self.axle,
-            "vertical_force": force[2],
-            "torque": -(moment @ self.axle),
-            "sinkage": self.bed.surface_height + r - hub[2],
-            "tread_sinkage": self.bed.surface_height - float(nodes[self._tread_nodes, 2].min()),
-            "slip": longitudinal_slip(vx, spin, r),
-            "slip_angle": slip_angle_deg(vel, self.heading, self.axle),
-            "tread_slip": longitudinal_slip(vx_tread, tread_omega, r),
-            "tread_slip_angle": slip_angle_deg(vel, tread.heading, tread.axle),
-            "wind_up": tread.wind_up,
-            "tread_omega": tread_omega,
-            "slip_speed": vx_tread,
-            "load": s.load if phase != "lower" else 0.0,
-            "omega": spin,
-            "travel": hub[0] + loop.shift - self.start_x,
-            "hub_x": hub[0], "hub_y": hub[1], "hub_z": hub[2],
-            "contacts": self.contact.contact_count,
-        }
 
     def detect(self) -> SteadyState:
         """The steady-state detector's verdict on the rows so far (:func:`~.run_statistics.detect_from_rows`)."""
