@@ -19,11 +19,12 @@ on one bed per seed (a sweep over ``case.seed``: finished replicas are kept) and
   case's reruns at later commits scatter as much as its seeds); it is added in quadrature to each level's error by
   ``wheelsoil convergence --replicas``. And the **replicas' mean with its 95 % interval**, t(0.975, n - 1) s /
   sqrt(n): the error bar the replicas give a number;
-* with factors from another replica set of n_f runs (``--widen-by REPLICAS_JSON``, :class:`ReplicaSpread`: per quantity
-  f = max(1, its inflation)), the coverage of the runs' intervals widened to t(0.975, n_f - 1) f sem: the check, on
-  replicas not used to set the factors, that a widened single-run interval holds as often as it claims. Student's t
-  at n_f - 1 degrees of freedom carries the factor's own scatter: f sem is an estimate of the spread from n_f runs,
-  so a normal 1.96 f sem would hold only about 88 % of the time with n_f = 5 (tests/test_cases_replicas.py).
+* with factors from another replica set of n_f runs (``--widen-by REPLICAS_JSON``, :class:`ReplicaSpread`: per
+  quantity f = max(1, its inflation)), the coverage of the runs' intervals widened to t(0.975, n_f - 1) f sem (never
+  below the run's own ``ci95``): the check, on replicas not used to set the factors, that a widened single-run
+  interval holds as often as it claims. Student's t at n_f - 1 degrees of freedom carries the factor's own scatter:
+  f sem is an estimate of the spread from n_f runs, so a normal 1.96 f sem would hold only about 88 % of the time
+  with n_f = 5 (tests/test_cases_replicas.py).
 
 Only steady runs count; runs that are not steady are listed.
 """
@@ -97,6 +98,8 @@ class ReplicaSpread:
 
     @classmethod
     def read(cls, path: str | Path, option: str = "--widen-by") -> "ReplicaSpread":
+        """The replica set of ``path``; a file that is not a ``replicas.json`` with at least two steady replicas is
+        refused, naming the command-line ``option`` it came from."""
         path = Path(path)
         try:
             stats = json.loads(path.read_text())
@@ -188,8 +191,8 @@ def report_markdown(name: str, stats: dict) -> str:
              "the mean of the other replicas. Excess: the spread no error bar from within one run sees, "
              "sqrt(max(0, spread^2 - mean own error^2)). The replicas' mean is given with its 95 % interval, "
              "t(n-1) spread / sqrt(n)."
-             + (f" Widened: the coverage with every run's 95 % interval widened to t(0.975, n_f - 1) f sem, f = "
-                f"max(1, inflation) as the {stats['widened_by']['replicas']} replicas of "
+             + (f" Widened: the coverage with every run's 95 % interval widened to t(0.975, n_f - 1) f sem (never "
+                f"below its own), f = max(1, inflation) as the {stats['widened_by']['replicas']} replicas of "
                 f"{stats['widened_by']['source']} measured it." if "widened_by" in stats else ""), "",
              "| quantity | mean (95 %) | spread | own error | excess | inflation | coverage |"
              + (" factor | coverage widened |" if "widened_by" in stats else ""),
@@ -197,7 +200,8 @@ def report_markdown(name: str, stats: dict) -> str:
     for q, (label, unit, scale) in QUANTITIES.items():
         r = stats["quantities"][q]
         if r["n"] < 2:
-            lines.append(f"| {label} [{unit}] | fewer than two steady replicas | | | | |")
+            empty = 5 + 2 * ("widened_by" in stats)
+            lines.append(f"| {label} [{unit}] | fewer than two steady replicas |" + " |" * empty)
             continue
         lo, hi = r["inflation_interval"]
         widened = (f" {r['factor']:.2f} | {r['covered_widened']} of {r['coverage_runs']} |"
