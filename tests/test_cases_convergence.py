@@ -244,3 +244,29 @@ def test_a_bad_replicas_file_is_refused_before_any_work(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--replicas" in err and "not a replicas.json" in err and "Traceback" not in err
     assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize("with_replicas", [False, True])
+def test_the_documented_scale_errors_are_what_the_stored_study_gives(with_replicas, capsys, monkeypatch):
+    """docs/testbed-numbers.md's extrapolation tables (without and with the replicas' spread) are what
+    docs/convergence_extrapolate.py prints from the stored study and the stored replicas: an example that is a test,
+    so the tables cannot drift from their command."""
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("docs_convergence_extrapolate",
+                                                  root / "docs" / "convergence_extrapolate.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.chdir(root)
+    argv = ["docs/convergence/smoke-1g-steer/convergence.json"]
+    if with_replicas:
+        argv += ["--replicas", "docs/replicas/smoke-1g-steer/replicas.json"]
+    assert script.main(argv) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| particle_size")
+            or line.startswith("| time_step") or line.startswith("| mesh")]
+    assert len(rows) == 18
+    documented = (root / "docs" / "testbed-numbers.md").read_text()
+    missing = [row for row in rows if row not in documented]
+    assert not missing, missing
