@@ -270,3 +270,27 @@ def test_the_documented_scale_errors_are_what_the_stored_study_gives(with_replic
     documented = (root / "docs" / "testbed-numbers.md").read_text()
     missing = [row for row in rows if row not in documented]
     assert not missing, missing
+
+
+def test_the_documented_error_budget_is_what_the_stored_studies_give(capsys, monkeypatch):
+    """docs/testbed-numbers.md's error budget is what docs/error_budget.py prints from the stored studies and replicas;
+    and its combination is the root-sum-square it states."""
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("docs_error_budget", root / "docs" / "error_budget.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.chdir(root)
+    assert script.main([]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| ")][1:]  # after the header
+    assert len(rows) == len(cv.QUANTITIES)
+    documented = (root / "docs" / "testbed-numbers.md").read_text()
+    assert not [row for row in rows if row not in documented]
+    # the combination, recomputed from the printed cells of the drawbar pull's row
+    cells = [c.strip() for c in rows[0].strip("|").split("|")]
+    pairs = [tuple(float(x) for x in c.split(" ± ")) for c in cells[3:8]]
+    scale_error = math.sqrt(sum(e * e + u * u for e, u in pairs))
+    assert float(cells[8]) == pytest.approx(scale_error, abs=0.6)
+    assert float(cells[9]) == pytest.approx(math.hypot(scale_error, float(cells[2])), abs=0.6)
