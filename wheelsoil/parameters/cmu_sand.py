@@ -19,6 +19,11 @@ What it still gets wrong (seed 0; docs/soillab/calibration-epsd-surface): the re
 two plates carry the same pressure where the sand's larger plate is stiffer per area. The shear box's peak angle
 is 45 deg at 5--20 kPa.
 
+The lab's 0.3 x 0.3 m box is too small for the 100 mm plate (docs/soillab/README.md, "The box check", 2026-11-28):
+doubled across, the same soil carries 13.4 / 18.1 / 23.0 kPa at 10 / 15 / 20 mm, 47--61 % less than in the lab's
+box, and 26--31 % softer than the sand below 10 mm. The calibration above matched the plates in the small box, so it
+carries that bias until it is run again in a box that passes the doubling check.
+
 The particles are coarser than sand grains: the calibration ran on 6.4--9.6 mm spheres; the CMU wheels (50 mm
 wide) need six particles across their width and run on the same particles scaled x0.8 (:data:`TWIN_DIAMETERS`),
 the scale of the CMU twin's cases (the plate's change over that step: docs/soillab/scale).
