@@ -36,6 +36,13 @@ def with_excess(values: dict | None, excess: dict | None) -> dict | None:
     return {**values, **{q: (values[q][0], math.hypot(values[q][1], excess.get(q, 0.0))) for q in QUANTITIES}}
 
 
+def stored_levels(study: dict, factor: str) -> list[tuple[float, dict | None]]:
+    """A factor's levels as (scale, values) from a stored ``convergence.json`` (``study``, as :func:`write_report`
+    writes it), with each quantity's (mean, sem) as a tuple, as :func:`_level_values` gives them."""
+    return [(lv["scale"], None if lv["values"] is None else
+             {**lv["values"], **{q: tuple(lv["values"][q]) for q in QUANTITIES}}) for lv in study["levels"][factor]]
+
+
 def _level_values(lv: Level) -> dict | None:
     if lv.folder is None or not (lv.folder / RESULT_NAME).is_file():
         return None

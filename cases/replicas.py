@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
-from scipy.stats import t as student_t
 
 from wheelsoil.coupling.run_summary import RunSummary
+from wheelsoil.coupling.steady import t_quantile
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output
 
@@ -88,11 +88,12 @@ def _summaries(sweep: Sweep) -> list[tuple[int, RunSummary | None]]:
 @dataclass(frozen=True)
 class ReplicaSpread:
     """What a replica set of ``replicas`` runs measured, read from its ``replicas.json`` (``source``): per quantity
-    the factor f = max(1, inflation) (1 where it measured none) and the excess spread sigma_x (0 where none; the
-    quantity's units)."""
+    the factor f = max(1, inflation) (1 where it measured none), the excess spread sigma_x (0 where none) and the
+    replicas' spread s (NaN where none; both in the quantity's units)."""
 
     factors: dict[str, float]
     excess: dict[str, float]
+    spread: dict[str, float]
     replicas: int
     source: str
 
@@ -109,16 +110,19 @@ class ReplicaSpread:
                                       f"({type(exc).__name__}: {exc})") from None
         if replicas < 2:
             raise WheelsoilInputError(f"{option} {path}: {replicas} steady replicas; a spread needs at least two")
-        factors, excess = {}, {}
+        factors, excess, spread = {}, {}, {}
         for q in QUANTITIES:
-            f = _finite(quantities.get(q, {}).get("inflation"))
+            row = quantities.get(q, {})
+            f = _finite(row.get("inflation"))
             factors[q] = max(1.0, f) if f is not None else 1.0
-            excess[q] = _finite(quantities.get(q, {}).get("excess_spread")) or 0.0
-        return cls(factors, excess, replicas, str(path))
+            excess[q] = _finite(row.get("excess_spread")) or 0.0
+            s = _finite(row.get("spread"))
+            spread[q] = s if s is not None else math.nan
+        return cls(factors, excess, spread, replicas, str(path))
 
     def half_width(self, quantity: str, sem):
         """The widened 95 % half-width t(0.975, n_f - 1) f sem (units of ``sem``)."""
-        return float(student_t.ppf(0.975, self.replicas - 1)) * self.factors[quantity] * np.asarray(sem, float)
+        return t_quantile(self.replicas - 1) * self.factors[quantity] * np.asarray(sem, float)
 
 
 def _finite(value) -> float | None:
@@ -151,7 +155,7 @@ def replica_statistics(summaries: list[tuple[int, RunSummary | None]], widening:
                        inflation_interval=[sd * math.sqrt((n - 1) / lo) / rms, sd * math.sqrt((n - 1) / hi) / rms]
                        if rms > 0 else [math.nan, math.nan])
             excess = math.sqrt(max(0.0, sd * sd - float(np.mean(sem ** 2)))) if math.isfinite(rms) else math.nan
-            row.update(excess_spread=excess, mean_ci95=float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n))
+            row.update(excess_spread=excess, mean_ci95=t_quantile(n - 1) * sd / math.sqrt(n))
             others = np.array([(x.sum() - x[k]) / (n - 1) for k in range(n)])
             reach = np.abs(x - others) / math.sqrt(1.0 + 1.0 / (n - 1))
             known = np.isfinite(ci)

@@ -45,8 +45,7 @@ def main(argv=None) -> int:
         levels = study["levels"].get(factor)
         if not levels or len(levels) < 2:
             continue
-        pairs = [(lv["scale"], report.with_excess(None if lv["values"] is None else
-                  {**lv["values"], **{q: tuple(lv["values"][q]) for q in cv.QUANTITIES}}, excess)) for lv in levels]
+        pairs = [(s, report.with_excess(v, excess)) for s, v in report.stored_levels(study, factor)]
         for row in report.extrapolate_levels(factor, pairs, floors, threshold):
             label, unit, scale = cv.QUANTITIES[row["quantity"]]
             scales = ", ".join(f"{s:g}" for s, _ in pairs)

@@ -39,11 +39,6 @@ REFINED = ("particle_size", "time_step", "mesh")
 DOUBLED = ("depth", "width")
 
 
-def _levels(study: dict, factor: str, quantities) -> list[tuple[float, dict | None]]:
-    return [(lv["scale"], None if lv["values"] is None else
-             {**lv["values"], **{q: tuple(lv["values"][q]) for q in quantities}}) for lv in study["levels"][factor]]
-
-
 def budget(study: dict, depth_study: dict | None, excess: dict, spread: dict, floors: dict, threshold: float) -> dict:
     """Per quantity: the reference value, each source as (relative error, its standard error) or a reason, the
     combined scale error and the one-run total (relative)."""
@@ -53,11 +48,11 @@ def budget(study: dict, depth_study: dict | None, excess: dict, spread: dict, fl
     out = {}
     sources = {}
     for factor in REFINED:
-        levels = [(s, report.with_excess(v, excess)) for s, v in _levels(study, factor, cv.QUANTITIES)]
+        levels = [(s, report.with_excess(v, excess)) for s, v in report.stored_levels(study, factor)]
         sources[factor] = {r["quantity"]: r for r in report.extrapolate_levels(factor, levels, floors, threshold)}
     for factor in DOUBLED:
         source = depth_study if factor == "depth" and depth_study is not None else study
-        levels = [(s, report.with_excess(v, excess)) for s, v in _levels(source, factor, cv.QUANTITIES)]
+        levels = [(s, report.with_excess(v, excess)) for s, v in report.stored_levels(source, factor)]
         sources[factor] = {}
         (_, ref), (_, doubled) = levels[0], levels[-1]
         for q in cv.QUANTITIES:
@@ -67,7 +62,7 @@ def budget(study: dict, depth_study: dict | None, excess: dict, spread: dict, fl
             scale = max(abs(doubled[q][0]), floors[q])
             sources[factor][q] = {"relative_error": (ref[q][0] - doubled[q][0]) / scale,
                                   "relative_error_se": math.hypot(ref[q][1], doubled[q][1]) / scale}
-    reference = _levels(study, "particle_size", cv.QUANTITIES)[0][1]
+    reference = report.stored_levels(study, "particle_size")[0][1]
     for q in cv.QUANTITIES:
         value = reference[q][0]
         scale = max(abs(value), floors[q])
@@ -102,9 +97,8 @@ def main(argv=None) -> int:
     study = json.loads(open(args.study).read())
     depth_study = json.loads(open(args.depth).read()) if args.depth else None
     replicas = ReplicaSpread.read(args.replicas, "--replicas")
-    spread = {q: json.loads(open(args.replicas).read())["quantities"][q]["spread"] for q in cv.QUANTITIES}
     floors = report.relative_floors(load_case(study["base"]))
-    rows = budget(study, depth_study, replicas.excess, spread, floors, float(study["threshold"]))
+    rows = budget(study, depth_study, replicas.excess, replicas.spread, floors, float(study["threshold"]))
 
     def cell(x):
         return x if isinstance(x, str) else f"{100 * x[0]:+.1f} ± {100 * x[1]:.1f}"

@@ -229,7 +229,8 @@ def test_replicas_excess_spread_widens_every_levels_error(mini, tmp_path, monkey
     rows = cr.comparison_rows(study, excess)
     r = next(r for r in rows if r["coarse_scale"] == 1.0 and r["quantity"] == "torque")
     assert r["change_sem"] == pytest.approx(math.hypot(math.hypot(0.01 * 612.0, 60.0), math.hypot(0.01 * 609.6, 60.0)))
-    spread = ReplicaSpread({q: 1.0 for q in base}, excess, 5, "replicas.json")
+    spread = ReplicaSpread({q: 1.0 for q in base}, excess, {q: 0.2 * abs(v) for q, v in base.items()}, 5,
+                           "replicas.json")
     cr.write_report(study, spread)
     text = (tmp_path / "convergence.md").read_text()
     assert "excess spread that the 5 replicas of replicas.json measured added in quadrature" in text

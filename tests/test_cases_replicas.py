@@ -132,12 +132,14 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
 
     rng = np.random.default_rng(5)
     stats = replica_statistics(_campaign(rng, 4, 1.0, 0.5), ReplicaSpread({q: 2.0 for q in QUANTITIES},
-                                                                          {q: 0.0 for q in QUANTITIES}, 5, "x"))
+                                                                          {q: 0.0 for q in QUANTITIES},
+                                                                          {q: 1.0 for q in QUANTITIES}, 5, "x"))
     r = stats["quantities"]["sinkage"]
     assert r["mean_ci95"] == pytest.approx(student_t.ppf(0.975, 3) * r["spread"] / 2.0)
     assert r["covered"] <= r["covered_widened"] <= r["coverage_runs"] == 4
     # a factor of 1 from many replicas (t near 1.96) never narrows a run's own wider interval
-    unit = ReplicaSpread({q: 1.0 for q in QUANTITIES}, {q: 0.0 for q in QUANTITIES}, 1000, "x")
+    unit = ReplicaSpread({q: 1.0 for q in QUANTITIES}, {q: 0.0 for q in QUANTITIES}, {q: 1.0 for q in QUANTITIES},
+                         1000, "x")
     wide_own = [(seed, replace(summary, **{q: replace(summary.quantity(q), ci95=100.0) for q in QUANTITIES}))
                 for seed, summary in _campaign(rng, 4, 1.0, 0.5)]
     assert replica_statistics(wide_own, unit)["quantities"]["torque"]["covered_widened"] == 4
@@ -151,12 +153,13 @@ def test_replicas_mean_interval_and_report_columns(tmp_path):
     with pytest.raises(WheelsoilInputError, match="not a replicas.json"):
         ReplicaSpread.read(tmp_path / "missing.json")
     ok = tmp_path / "ok.json"
-    quantities = {"drawbar_pull": {"inflation": 2.5, "excess_spread": 3.0},
+    quantities = {"drawbar_pull": {"inflation": 2.5, "excess_spread": 3.0, "spread": 4.0},
                   "torque": {"inflation": 0.4, "excess_spread": None}}
     ok.write_text(json.dumps({"steady": [0, 1, 2], "quantities": quantities}))
     widening = ReplicaSpread.read(ok)
     assert widening.factors["drawbar_pull"] == 2.5 and widening.factors["torque"] == 1.0
     assert widening.excess["drawbar_pull"] == 3.0 and widening.excess["torque"] == 0.0
+    assert widening.spread["drawbar_pull"] == 4.0 and math.isnan(widening.spread["torque"])
     assert widening.factors["sinkage"] == 1.0 and widening.replicas == 3
     assert widening.half_width("drawbar_pull", 1.0) == pytest.approx(student_t.ppf(0.975, 2) * 2.5)
     one = tmp_path / "one.json"
