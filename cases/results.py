@@ -40,6 +40,7 @@ import numpy as np
 
 from wheelsoil.coupling.run_summary import RunSummary
 from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.state_file import attr_value
 
 FRAME_FORMAT = "{:06d}"
 #: The statistics a summary keeps for each steady quantity.
@@ -224,15 +225,6 @@ class Result:
                 "radius": g["particles/radius"][()], "wheel_nodes": g["wheel/nodes"][()],
                 "deflection": g["wheel/deflection"][()].astype(float), "triangles": f["mesh/triangles"][()],
             }
-
-
-def attr_value(value):
-    """An HDF5 attribute as plain Python: bytes to str, NumPy scalars to Python numbers."""
-    if isinstance(value, bytes):
-        return value.decode()
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
 
 
 def load_result(path: str | Path) -> Result:

@@ -21,15 +21,14 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import h5py
-import numpy as np
 
 from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output, provenance, writable_folder
+from wheelsoil.state_file import load_state, save_state
 
 from . import build
-from .results import ResultWriter, attr_value, partial_path
+from .results import ResultWriter, partial_path
 from .schema import CaseFile, case_to_toml
 
 RESULT_NAME = "result.h5"
@@ -47,38 +46,8 @@ class RunOutcome:
 
 
 # -------------------------------------------------------------------- checkpoint files
-def _write_tree(group: h5py.Group, tree: dict) -> None:
-    for key, value in tree.items():
-        if isinstance(value, dict):
-            _write_tree(group.create_group(key), value)
-        elif isinstance(value, np.ndarray):
-            group.create_dataset(key, data=value)
-        else:
-            group.attrs[key] = value
-
-
-def _read_tree(group: h5py.Group) -> dict:
-    out = {k: attr_value(v) for k, v in group.attrs.items()}
-    for key, item in group.items():
-        out[key] = _read_tree(item) if isinstance(item, h5py.Group) else item[()]
-    return out
-
-
-def save_checkpoint(path: Path, state: dict, meta: dict) -> None:
-    """Write a testbed state (nested dict of arrays and scalars) and ``meta`` atomically."""
-    with atomic_output(path) as tmp:
-        with h5py.File(tmp, "w") as f:
-            _write_tree(f.create_group("state"), state)
-            for key, value in meta.items():
-                f.attrs[key] = value
-
-
-def load_checkpoint(path: Path) -> tuple[dict, dict]:
-    """(state, meta) of a checkpoint file."""
-    with h5py.File(path, "r") as f:
-        state = _read_tree(f["state"])
-        meta = {k: attr_value(v) for k, v in f.attrs.items()}
-    return state, meta
+#: Write a testbed state (nested dict of arrays and scalars) and its ``meta`` atomically; read one back.
+save_checkpoint, load_checkpoint = save_state, load_state
 
 
 # -------------------------------------------------------------------- the run

@@ -11,9 +11,11 @@ footprint): on sand of real grains the lab's zero, the first contact of the plat
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -23,6 +25,7 @@ from wheelsoil.granular.bed import Bed, prepare_bed
 from wheelsoil.granular.bed_spec import BedSpec
 from wheelsoil.granular.materials import STEEL, PairProperties
 from wheelsoil.parameters import cmu_k10
+from wheelsoil.state_file import load_state, save_state
 
 from .measured import LoadCurve, plate_area
 from .rigid import RigidTool
@@ -74,16 +77,70 @@ def footprint_surface(bed: Bed, center_xy, half_x: float, half_y: float) -> tupl
     return float(highest.mean()), float(top.max())
 
 
+@dataclass(frozen=True)
+class PressCheckpoint:
+    """Where and how often a pressing test keeps the state to continue from (for tests of hours, e.g. a plate in a
+    box of 300,000 spheres).
+
+    path: the checkpoint file; a run that finds one there written for the same test (``key``) continues from it,
+    and the file is removed once the test has finished. key: what the test is (bed, tool, speeds, contact), so that
+    a file of another test is never continued. every: samples between two checkpoints (>= 1).
+
+    Taking a state rebuilds the neighbour lists at the next step, so a test with checkpoints follows another
+    trajectory than one without (at round-off, then chaotically); with the same ``every`` the trajectory, and the
+    curve, are the same bit for bit whether or not the run was interrupted."""
+
+    path: Path
+    key: str
+    every: int = 10
+
+    def __post_init__(self) -> None:
+        if int(self.every) != self.every or self.every < 1:
+            raise WheelsoilInputError(f"checkpoint every = {self.every!r} samples: give a whole number >= 1")
+
+
+def press_key(*parts) -> str:
+    """A short digest of the test's description (dataclasses of specs, numbers): a checkpoint's ``key``."""
+    return hashlib.sha256(repr(parts).encode()).hexdigest()[:16]
+
+
+def _take_state(tool: RigidTool, sinkage: list, force: list) -> dict:
+    state = {"scene": tool.scene.state(), "structure": tool.structure.state(), "contact": tool.contact.state(),
+             "press": {"sinkage": np.asarray(sinkage, float), "force": np.asarray(force, float)}}
+    tool.contact.invalidate()  # as the restored run must, so both step alike from here
+    return state
+
+
+def _restore(tool: RigidTool, checkpoint: PressCheckpoint) -> tuple[list, list] | None:
+    """The samples so far from ``checkpoint``'s file, with the tool and soil restored; None without a file of it."""
+    if not checkpoint.path.is_file():
+        return None
+    state, meta = load_state(checkpoint.path)
+    if meta.get("key") != checkpoint.key:
+        raise WheelsoilInputError(f"{checkpoint.path} is the checkpoint of another test (key {meta.get('key')}, this "
+                                  f"test {checkpoint.key}): remove it, or run the test it was written for")
+    tool.scene.restore_state(state["scene"])
+    tool.structure.restore_state(state["structure"])
+    tool.contact.restore_state(tool.scene, state["contact"])
+    press = state["press"]
+    return [float(v) for v in np.atleast_1d(press["sinkage"])], [float(v) for v in np.atleast_1d(press["force"])]
+
+
 def _press(tool: RigidTool, bottom_offset: float, surface: float, speed: float, max_sinkage: float,
-           sample_interval: float, progress: bool, label: str) -> tuple[np.ndarray, np.ndarray, int]:
+           sample_interval: float, progress: bool, label: str,
+           checkpoint: PressCheckpoint | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """Move ``tool`` down at ``speed`` until its lowest point is ``max_sinkage`` below ``surface``; returns the
-    sinkage [m] and the soil's vertical force [N] of every sample and the steps taken."""
+    sinkage [m] and the soil's vertical force [N] of every sample and the steps taken. With ``checkpoint`` the state
+    is kept every ``checkpoint.every`` samples and a kept state of the same test is continued."""
     scene = tool.scene
     dt = scene.time_step
     steps = max(1, int(round(sample_interval / speed / dt)))
+    sinkage, force = [], []
+    resumed = _restore(tool, checkpoint) if checkpoint is not None else None
+    if resumed is not None:
+        sinkage, force = resumed
     tool.move((0.0, 0.0, -speed))
     tool.soil_force()
-    sinkage, force = [], []
     depth_at = lambda: surface - (tool.position[2] + bottom_offset)  # noqa: E731
     total = max_sinkage - depth_at()
     bar = _Bar(label, total) if progress else None
@@ -94,10 +151,15 @@ def _press(tool: RigidTool, bottom_offset: float, surface: float, speed: float, 
             force.append(float(tool.soil_force()[2]))
             if bar is not None:
                 bar.advance(steps * dt * speed)
+            if checkpoint is not None and len(sinkage) % checkpoint.every == 0 and depth_at() < max_sinkage:
+                save_state(checkpoint.path, _take_state(tool, sinkage, force),
+                           {"key": checkpoint.key, "samples": len(sinkage), "t": scene.time})
     finally:
         if bar is not None:
             bar.stop()
     tool.hold()
+    if checkpoint is not None:
+        checkpoint.path.unlink(missing_ok=True)
     return np.asarray(sinkage), np.asarray(force), len(sinkage) * steps
 
 
@@ -141,9 +203,11 @@ def _result(bed: Bed, curve: LoadCurve, surface: float, highest: float, speed: f
 
 
 def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | None = None, cache_dir=None,
-               arch: str | None = None, progress: bool = False) -> PenetrationResult:
+               arch: str | None = None, progress: bool = False,
+               checkpoint: str | Path | None = None, checkpoint_every: int = 10) -> PenetrationResult:
     """Press a rigid circular plate into the bed of ``bed_spec`` (checked before any work: the plate inside the
-    box, enough particles across it)."""
+    box, enough particles across it). ``checkpoint``: a file to keep the state in every ``checkpoint_every``
+    samples, continued when the same test runs again after an interruption (:class:`PressCheckpoint`)."""
     check_plate_fits("plate diameter", plate.diameter, bed_spec.length, bed_spec.width)
     check_resolution("plate diameter", plate.diameter, bed_spec.diameter_max)
     bed, bed_seconds = _bed(bed_spec, cache_dir, arch)
@@ -157,8 +221,10 @@ def plate_test(bed_spec: BedSpec, plate: PlateSpec, *, pair: PairProperties | No
     scene = bed.to_scene(headroom=max(plate.max_sinkage, 0.05), arch=arch)
     tool = RigidTool(scene, nodes + (center[0], center[1], z0), tri, plate.thickness,
                      pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL)
+    keep = None if checkpoint is None else PressCheckpoint(
+        Path(checkpoint), press_key("plate", bed_spec, plate, pair, checkpoint_every), checkpoint_every)
     sinkage, force, steps = _press(tool, -0.5 * plate.thickness, surface, plate.speed, plate.max_sinkage,
-                                   plate.sample_interval, progress, f"plate {1e3 * plate.diameter:g} mm")
+                                   plate.sample_interval, progress, f"plate {1e3 * plate.diameter:g} mm", keep)
     curve = LoadCurve("plate", plate.diameter, f"DEM, {1e3 * plate.diameter:g} mm plate, seed {bed_spec.seed}",
                       sinkage, force, area=plate_area(plate.diameter))
     return _result(bed, curve, surface, highest, plate.speed, plate.diameter, plate.area, tool, steps,
@@ -174,8 +240,10 @@ def cmu_wheel(name: str, element_size: float | None = None) -> WheelGeometry:
 
 
 def wheel_press_test(bed_spec: BedSpec, press: WheelPressSpec, *, pair: PairProperties | None = None,
-                     cache_dir=None, arch: str | None = None, progress: bool = False) -> PenetrationResult:
-    """Press a rigid CMU wheel, axle along y, straight down into the bed of ``bed_spec``."""
+                     cache_dir=None, arch: str | None = None, progress: bool = False,
+                     checkpoint: str | Path | None = None, checkpoint_every: int = 10) -> PenetrationResult:
+    """Press a rigid CMU wheel, axle along y, straight down into the bed of ``bed_spec`` (``checkpoint``: as
+    :func:`plate_test`'s)."""
     wheel = cmu_wheel(press.wheel, press.element_size)
     outer = wheel.radius + wheel.grouser_height
     check_plate_fits("wheel diameter", 2 * outer, bed_spec.length, bed_spec.length)
@@ -202,8 +270,10 @@ def wheel_press_test(bed_spec: BedSpec, press: WheelPressSpec, *, pair: PairProp
     tool = RigidTool(scene, mesh.nodes[used] + (center[0], center[1], z0), renumber[tri], thickness,
                      pair or bed_spec.wall_pair, material=bed_spec.wall_material or STEEL,
                      center=(center[0], center[1], z0))
+    keep = None if checkpoint is None else PressCheckpoint(
+        Path(checkpoint), press_key("wheel", bed_spec, press, pair, checkpoint_every), checkpoint_every)
     sinkage, force, steps = _press(tool, lowest, surface, press.speed, press.max_sinkage, press.sample_interval,
-                                   progress, f"{press.wheel} wheel")
+                                   progress, f"{press.wheel} wheel", keep)
     curve = LoadCurve("wheel", wheel.radius, f"DEM, {press.wheel} wheel, seed {bed_spec.seed}", sinkage, force,
                       wheel=press.wheel)
     return _result(bed, curve, surface, highest, press.speed, wheel.width, 2 * chord * wheel.width, tool, steps,

@@ -124,3 +124,10 @@ def test_a_pour_friction_factor_outside_zero_to_one_is_refused(tmp_path, capsys)
              "pour_friction_factor = 2.0", "0 <= pour_friction_factor <= 1")
     _refused(["prepare-bed", "smoke-1g-steer", "--set", "soil.pour_friction_factor=-0.5", "--out",
               str(tmp_path / "bed")], capsys, "soil.pour_friction_factor")
+
+
+def test_a_soil_lab_checkpoint_of_no_samples_or_of_a_test_that_keeps_none_is_refused(tmp_path, capsys):
+    _refused(["soil-lab", "plate", "--checkpoint-every", "0", "--out", str(tmp_path / "lab")], capsys,
+             "--checkpoint-every = 0", ">= 1")
+    _refused(["soil-lab", "shear", "--checkpoint-every", "5", "--out", str(tmp_path / "lab")], capsys,
+             "--checkpoint-every = 5", "plate and wheel tests only")

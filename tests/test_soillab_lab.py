@@ -49,6 +49,42 @@ def test_plate_force_starts_at_zero_and_rises(bed_cache):
     assert 0.5 < result.packing_fraction < 0.65
 
 
+def test_an_interrupted_plate_test_continues_to_the_same_curve(bed_cache, tmp_path, monkeypatch):
+    """A plate test killed after its second checkpoint and run again continues from it to the curve, bit for bit, of
+    the same test run through (both keep a state every 2 samples); the finished test leaves no checkpoint."""
+    from wheelsoil.soillab import penetration
+
+    spec = PlateSpec(diameter=0.05, speed=0.1, max_sinkage=0.008, sample_interval=0.001)
+    through = plate_test(small_bed(), spec, cache_dir=bed_cache, checkpoint=tmp_path / "a.h5", checkpoint_every=2)
+    assert not (tmp_path / "a.h5").exists()
+
+    saved = []
+    real_save = penetration.save_state
+
+    def save_then_die(path, state, meta):
+        real_save(path, state, meta)
+        saved.append(meta["samples"])
+        if len(saved) == 2:
+            raise KeyboardInterrupt("killed after the second checkpoint")
+
+    monkeypatch.setattr(penetration, "save_state", save_then_die)
+    with pytest.raises(KeyboardInterrupt):
+        plate_test(small_bed(), spec, cache_dir=bed_cache, checkpoint=tmp_path / "b.h5", checkpoint_every=2)
+    assert saved == [2, 4] and (tmp_path / "b.h5").is_file()
+    later = []
+    monkeypatch.setattr(penetration, "save_state", lambda p, st, meta: (later.append(meta["samples"]),
+                                                                        real_save(p, st, meta)))
+    resumed = plate_test(small_bed(), spec, cache_dir=bed_cache, checkpoint=tmp_path / "b.h5", checkpoint_every=2)
+    assert len(through.curve.force) > 6 and later[0] == 6  # it went on from the fourth sample, not from the start
+    np.testing.assert_array_equal(resumed.curve.sinkage, through.curve.sinkage)
+    np.testing.assert_array_equal(resumed.curve.force, through.curve.force)
+    assert not (tmp_path / "b.h5").exists()
+    # another test's checkpoint is never continued
+    real_save(tmp_path / "c.h5", {"x": np.zeros(1)}, {"key": "another test"})
+    with pytest.raises(penetration.WheelsoilInputError, match="checkpoint of another test"):
+        plate_test(small_bed(), spec, cache_dir=bed_cache, checkpoint=tmp_path / "c.h5", checkpoint_every=2)
+
+
 def test_poured_bed_over_seeds(bed_cache):
     """Bulk density = packing fraction x particle density, per seed; other seeds give other packings."""
     beds = poured_bed_test(small_bed(), seeds=(0, 1), cache_dir=bed_cache)

@@ -70,6 +70,11 @@ def add_parser(sub) -> None:
     parser.add_argument("--out", type=Path, default=Path("wheelsoil-output/soil-lab"), help="output folder")
     parser.add_argument("--cache", type=Path, default=None, help="bed cache folder (default the user cache)")
     parser.add_argument("--progress", action="store_true", help="progress bars on the terminal")
+    parser.add_argument("--checkpoint-every", type=int, default=None, metavar="SAMPLES",
+                        help="plate, wheel: keep the state every SAMPLES samples in OUT/.TEST-...checkpoint.h5, so "
+                             "that the same command run again after an interruption continues the test from there (a test "
+                             "already finished in that command is run again); the same SAMPLES gives the same curve, "
+                             "interrupted or not, and another than a run without checkpoints (default: none)")
     common.add_arch_option(parser)
     parser.set_defaults(func=run)
 
@@ -147,6 +152,9 @@ def run(args) -> int:
 
     if args.test not in TESTS:
         raise WheelsoilInputError(f"soil-lab TEST = {args.test!r} is unknown; choose one of {list(TESTS)}")
+    if args.checkpoint_every is not None and (args.test not in ("plate", "wheel") or args.checkpoint_every < 1):
+        raise WheelsoilInputError(f"--checkpoint-every = {args.checkpoint_every}: give a whole number of samples >= 1, "
+                                  "for the plate and wheel tests only")
     seeds, bed_spec, spec = _specs(args)
     friction_angle, cohesion = _shear_envelope(args.shear_json) if args.test == "plate" else (None, 0.0)
     measured = _measured(args) if args.test in ("plate", "wheel") and (args.measured or _shared_present()) else []
@@ -164,15 +172,25 @@ def run(args) -> int:
         for seed in seeds:
             bed = dataclasses.replace(bed_spec, seed=seed)
             if args.test == "plate":
-                results += [soillab.plate_test(bed, s, **common) for s in spec]
+                results += [soillab.plate_test(bed, s, **common,
+                                               **_checkpoint(args, out, f"plate-{1e3 * s.diameter:g}mm-seed{seed}"))
+                            for s in spec]
             else:
-                results.append(soillab.wheel_press_test(bed, spec, **common))
+                results.append(soillab.wheel_press_test(bed, spec, **common,
+                                                        **_checkpoint(args, out, f"wheel-{spec.wheel}-seed{seed}")))
         figures, paths = report.write_penetration(results, measured, out, args.test, friction_angle=friction_angle,
                                                   cohesion=cohesion)
     console.print(f"soil-lab {args.test}: " + report.headline(args.test, figures))
     for p in paths.values():
         console.print(f"  wrote {p}")
     return 0
+
+
+def _checkpoint(args, out: Path, name: str) -> dict:
+    """The pressing test's checkpoint options (none without --checkpoint-every)."""
+    if args.checkpoint_every is None:
+        return {}
+    return {"checkpoint": out / f".{name}.checkpoint.h5", "checkpoint_every": args.checkpoint_every}
 
 
 def _shared_present() -> bool:
