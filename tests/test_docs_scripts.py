@@ -5,9 +5,11 @@ breaks a test here instead of the next campaign. (Running them is hours of DEM e
 import ast
 import importlib
 import importlib.util
+import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
@@ -61,3 +63,34 @@ def test_the_twin_queue_links_a_finished_run_as_a_bin_checks_reference(tmp_path)
     other.mkdir()
     (other / RESULT_NAME).write_bytes(b"")
     assert sorted(p.name for p in (out / "cases").iterdir()) == [digest]  # only the case's own hash
+
+
+def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_dir):
+    """docs/cmu_twin_runs.py reads a finished run's case.toml and summary.json, pairs it with the measured trial of
+    its wheel, steering angle, slip and load, and gives the residual in the trial's standard deviations; a run not
+    steady is marked as giving no number."""
+    from wheelsoil.validation.measured import load_cmu_trials
+
+    table = _load("cmu_twin_runs")
+    data = load_cmu_trials(Path(measured_dir) / "cmu_3d_terramechanics")
+    k = int(np.flatnonzero((data.grouser_height > 0) & (data.slip_angle == 45.0)
+                           & (np.abs(data.travel_slip - 0.5) <= 0.05))[0])
+    quantity = lambda mean: {"mean": mean, "ci95": 0.5}  # noqa: E731
+    for name, steady in (("a1", True), ("b2", False)):
+        folder = tmp_path / "cmu-some-sweep" / "cases" / name
+        folder.mkdir(parents=True)
+        folder.joinpath("case.toml").write_text(
+            f'[case]\nseed = 1\n[soil]\nlength = 0.3\nwidth = 0.2\ndepth = 0.1\n[wheel]\npreset = "cmu-k10-grouser"\n'
+            f'[test]\nslip = {data.travel_slip[k]}\nslip_angle = 45.0\nload = {data.load[k]}\ndrive_time = 20.0\n')
+        summary = {"steady": steady, "window": [2.0, 9.0], "tread_slip": {"mean": 0.5}, "vertical_force": {"mean": 20.0},
+                   "drawbar_pull": quantity(data.responses["drawbar_pull"][k] + 2 * data.std["drawbar_pull"][k]),
+                   "lateral_force": quantity(-1.0), "tread_sinkage": quantity(0.03)}
+        folder.joinpath("summary.json").write_text(json.dumps(
+            {"summary": summary, "run": {"wall_seconds": 100.0, "simulated_seconds": 9.0}}))
+    records = table.finished_runs(tmp_path)
+    table.pair_with_trials(records, data)
+    assert [r["case_hash"] for r in records] == ["a1", "b2"]
+    assert all(r["trial"] is not None for r in records)
+    lines = table.markdown(records)
+    assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
+    assert "**no**" in lines[3]

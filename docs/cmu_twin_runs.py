@@ -1,0 +1,146 @@
+"""Every finished run of the CMU twin beside the trial it twins (issue 34), read from the runs' own files, so that no
+number in docs/cmu-twin/README.md is copied by hand.
+
+For each sweep folder ``RUNS/cmu-*`` (the subset, the candidates, the replicas, the speed check) and each case in it
+that has finished (``summary.json``): the wheel, steering angle, commanded slip, load and seed from its
+``case.toml``; whether the steady-state detector found it steady and over which window; the steady (or, where not
+steady, the window's) means of the drawbar pull, the lateral force and the tread sinkage with their 95 % intervals
+(the detector's own: one run's, without the run-to-run spread the replicas measure); and the measured trial of the
+same wheel, steering angle and load (each trial's load is its own) with its mean and standard deviation, in wheelsoil's
+signs (``wheelsoil.validation.measured.load_cmu_trials``). A run that is not steady gives no number (rule 2 of the
+README); it is listed, marked, for information.
+
+Writes ``OUT/runs.md`` and ``OUT/runs.json``, and copies each sweep's ``summary.csv`` to ``OUT/<sweep>/summary.csv``,
+so that ``wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --model OUT/<sweep>`` and
+``python docs/validation_lab_model.py --twin OUT/<sweep>`` run from the repository.
+
+Usage (from the repository root; seconds)::
+
+    python docs/cmu_twin_runs.py --runs RUNS --out docs/cmu-twin/runs
+"""
+
+import argparse
+import json
+import math
+import shutil
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+MEASURED = Path("..") / "shared" / "data" / "measured" / "cmu_3d_terramechanics"
+#: The responses tabulated: summary quantity -> (dataset response, label, scale to the printed unit, unit).
+QUANTITIES = {"drawbar_pull": ("drawbar_pull", "drawbar pull", 1.0, "N"),
+              "lateral_force": ("lateral_force", "lateral force", 1.0, "N"),
+              "tread_sinkage": ("sinkage", "tread sinkage", 1e3, "mm")}
+
+
+def finished_runs(runs: Path) -> list[dict]:
+    """One record per finished case of every ``runs/cmu-*`` sweep folder (sorted by sweep and case hash); a case
+    folder linked from another sweep (a convergence study's reference) is listed once, under its own sweep."""
+    out, seen = [], set()
+    for sweep in sorted(p for p in runs.glob("cmu-*") if p.is_dir()):
+        for folder in sorted((sweep / "cases").glob("*")):
+            if not (folder / "summary.json").is_file() or folder.resolve() in seen:
+                continue
+            seen.add(folder.resolve())
+            case = tomllib.loads((folder / "case.toml").read_text())
+            summary = json.loads((folder / "summary.json").read_text())
+            s = summary["summary"]
+            record = {"sweep": sweep.name, "case_hash": folder.name, "wheel": case["wheel"]["preset"],
+                      "seed": case["case"]["seed"], "slip": case["test"]["slip"],
+                      "slip_angle": case["test"]["slip_angle"], "load": case["test"]["load"], "drive_time": case["test"]["drive_time"],
+                      "bin": [case["soil"]["length"], case["soil"]["width"], case["soil"]["depth"]],
+                      "steady": bool(s["steady"]), "window": s["window"], "reasons": s.get("reasons", []),
+                      "wall_seconds": summary["run"].get("wall_seconds"),
+                      "simulated_seconds": summary["run"].get("simulated_seconds")}
+            for q in QUANTITIES:
+                record[q] = {"mean": s[q]["mean"], "ci95": s[q]["ci95"]}
+            record["tread_slip"] = s["tread_slip"]["mean"]
+            record["vertical_force"] = s["vertical_force"]["mean"]
+            out.append(record)
+    return out
+
+
+def pair_with_trials(records: list[dict], data) -> None:
+    """Add each record's measured trial (same wheel, steering angle, commanded slip within 0.05 and load within 1 mN),
+    or None where none matches."""
+    grouser = data.grouser_height > 0
+    for r in records:
+        at = (grouser == r["wheel"].endswith("grouser")) & (data.slip_angle == r["slip_angle"])
+        at &= (np.abs(data.travel_slip - r["slip"]) <= 0.05) & (np.abs(data.load - r["load"]) < 1e-3)
+        rows = np.flatnonzero(at)
+        r["trial"] = None if len(rows) != 1 else {
+            q: {"mean": float(data.responses[name][rows[0]]),
+                "std": float(data.std[name][rows[0]]) if name in data.std else math.nan}
+            for q, (name, *_) in QUANTITIES.items()}
+
+
+def _cell(value: dict, scale: float) -> str:
+    return f"{scale * value['mean']:+.2f} ± {scale * value['ci95']:.2f}"
+
+
+def markdown(records: list[dict]) -> list[str]:
+    """The table: one row per run, its measured trial and residuals in trial standard deviations."""
+    head = ("| sweep | wheel, β, slip, load, seed, drive | steady (window) | " +
+            " | ".join(f"{label} [{unit}]: twin (95 %) / trial (std) / residual in trial stds"
+                       for _, label, _, unit in QUANTITIES.values()) + " | wall / simulated |")
+    lines = [head, "|" + "---|" * (4 + len(QUANTITIES))]
+    for r in records:
+        steady = (f"yes ({r['window'][0]:.2f}–{r['window'][1]:.2f} s)" if r["steady"]
+                  else f"**no** (window {r['window'][0]:.2f}–{r['window'][1]:.2f} s, not a number)")
+        cells = []
+        for q, (_, _, scale, _) in QUANTITIES.items():
+            cell = _cell(r[q], scale)
+            trial = r["trial"][q] if r["trial"] else None
+            if trial is not None and q != "tread_sinkage":
+                z = (r[q]["mean"] - trial["mean"]) / trial["std"] if trial["std"] > 0 else math.nan
+                cell += f" / {scale * trial['mean']:+.2f} ({scale * trial['std']:.2f}) / {z:+.1f}"
+            elif trial is not None:  # the trials' sinkage is from the start position, the twin's from the surface
+                cell += f" / {scale * trial['mean']:.1f} (from the start position) / –"
+            cells.append(cell)
+        wheel = r["wheel"].replace("cmu-k10-", "")
+        bin_note = "" if r["bin"] == [0.3, 0.2, 0.1] else f", bin {r['bin'][1]:g} × {r['bin'][2]:g} m"
+        lines.append(f"| {r['sweep'].replace('cmu-', '')} | {wheel}, {r['slip_angle']:g}°, {r['slip']:+.3f}, "
+                     f"{r['load']:.2f} N, seed {r['seed']}, {r['drive_time']:g} s drive{bin_note} | {steady} | " + " | ".join(cells) +
+                     f" | {r['wall_seconds']:.0f} s / {r['simulated_seconds']:.2f} s |")
+    return lines
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--runs", required=True, help="folder of the twin's sweeps (outside the repository)")
+    ap.add_argument("--out", default="docs/cmu-twin/runs")
+    ap.add_argument("--data", default=str(MEASURED))
+    args = ap.parse_args(argv)
+
+    from wheelsoil.provenance import provenance, write_markdown_and_json
+    from wheelsoil.validation.measured import load_cmu_trials
+
+    runs, out = Path(args.runs), Path(args.out)
+    records = finished_runs(runs)
+    pair_with_trials(records, load_cmu_trials(args.data))
+    out.mkdir(parents=True, exist_ok=True)
+    for sweep in sorted({r["sweep"] for r in records}):
+        if (runs / sweep / "summary.csv").is_file():
+            (out / sweep).mkdir(exist_ok=True)
+            shutil.copyfile(runs / sweep / "summary.csv", out / sweep / "summary.csv")
+    steady = sum(r["steady"] for r in records)
+    lines = ["# The CMU twin's finished runs beside their trials (issue 34)", "",
+             f"Generated by `python docs/cmu_twin_runs.py --runs RUNS --out {args.out}` from the runs' own "
+             "`case.toml` and `summary.json`; the rules that judge them are in [the twin's README](../README.md). "
+             f"{len(records)} finished runs, {steady} of them steady. The intervals are each run's own (the steady-"
+             "state detector's 95 %), without the run-to-run spread; a run not steady gives no number and is listed "
+             "for information. Signs are wheelsoil's (the lateral force opposes the lateral slip); the residual is "
+             "(twin − trial) / the trial's std. The trials' sinkage is measured from the wheel's start position, the "
+             "twin's tread sinkage from the levelled surface, so they are shown and not compared.", "",
+             *markdown(records), ""]
+    write_markdown_and_json(out / "runs.md", "\n".join(lines), out / "runs.json",
+                            {"runs": records, "provenance": provenance()}, default=float)
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
