@@ -73,6 +73,10 @@ DESIGNS = {
     "packing": ((0.5, 0.5, 0.0, True, "cdt"), (0.5, 0.5, 0.25, True, "cdt"), (0.5, 0.5, 1.0, True, "cdt")),
     "epsd": tuple((mu, mu_r, 1.0, True, "epsd") for mu in FRICTIONS for mu_r in ROLLING),
     "epsd-surface": ((0.52, 0.5, 1.0, True, "epsd"),),
+    # the EPSD grid and its surface's minimum again, their plates in a box that passes the box check
+    # (docs/soillab/box): run with --box and --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface
+    "epsd-box": tuple((mu, mu_r, 1.0, True, "epsd") for mu in FRICTIONS for mu_r in ROLLING)
+                + ((0.52, 0.5, 1.0, True, "epsd"),),
 }
 
 
@@ -81,7 +85,30 @@ def candidate_name(mu: float, mu_r: float, pour: float, law: str = "cdt") -> str
             + ("" if law == "cdt" else f"_{law}"))
 
 
-def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False, law: str = "cdt") -> dict:
+#: What a candidate keeps from an earlier calibration's file of the same particles when only its plates run again
+#: (``--reuse``): the density fixed in the lab's box, that bed's packing, the repose and the shear box.
+REUSED_KEYS = ("friction", "rolling_friction", "pour_friction_factor", "rolling_model", "density", "packing_fraction",
+               "bulk_density", "repose_deg", "shear")
+
+
+def reused_row(folders, name: str) -> dict | None:
+    """The candidate file ``name`` (without .json) of the first of ``folders`` that has one, less its plates and
+    scores (``REUSED_KEYS`` and where it came from); None where none has it."""
+    for folder in folders:
+        path = Path(folder) / "candidates" / f"{name}.json"
+        if path.is_file():
+            row = json.loads(path.read_text())
+            kept = {k: row[k] for k in REUSED_KEYS if k in row}
+            kept["reused_from"] = str(path)
+            return kept
+    return None
+
+
+def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False, law: str = "cdt",
+              box: dict | None = None, reused: dict | None = None, checkpoints: Path | None = None) -> dict:
+    """One candidate through the lab: density, repose and (``shear``) the shear box in the lab's box, unless
+    ``reused`` gives them (:func:`reused_row`); the plates in ``box`` (default the lab's ``PLATE_BOX``), keeping their
+    state in ``checkpoints`` (a folder) so that an interrupted plate continues."""
     from wheelsoil import soillab
     from wheelsoil.granular.bed import prepare_bed
     from wheelsoil.granular.bed_spec import BedSpec
@@ -94,36 +121,45 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
                           rolling_model=law)
     tool_pair = dataclasses.replace(soil_lab.TOOL_PAIR, rolling_model=law)
 
-    def spec(density):
+    def spec(density, where=soil_lab.PLATE_BOX):
         material = Material("calibration", youngs_modulus=base.youngs_modulus, poisson_ratio=base.poisson_ratio,
                             density=density)
-        return BedSpec(**soil_lab.PLATE_BOX, diameter_min=soil_lab.DIAMETER_MIN, diameter_max=soil_lab.DIAMETER_MAX,
+        return BedSpec(**where, diameter_min=soil_lab.DIAMETER_MIN, diameter_max=soil_lab.DIAMETER_MAX,
                        material=material, pair=pair, wall_material=soil_lab.TOOL_MATERIAL,
                        wall_pair=tool_pair, periodic=False, seed=0, pour_friction_factor=pour)
 
-    bed_spec = spec(base.density)
-    bed = prepare_bed(bed_spec, cache_dir=cache)
-    phi = bed.packing_fraction
-    if abs(phi * base.density / cmu_k10.BULK_DENSITY - 1.0) > 0.01:
-        bed_spec = spec(round(cmu_k10.BULK_DENSITY / phi, 1))
+    if reused is not None:
+        row = dict(reused)
+        bed_spec = spec(row["density"])
+    else:
+        bed_spec = spec(base.density)
         bed = prepare_bed(bed_spec, cache_dir=cache)
-    repose = soillab.repose_test(bed_spec, soillab.ReposeSpec(seeds=(0,)), cache_dir=cache)
+        phi = bed.packing_fraction
+        if abs(phi * base.density / cmu_k10.BULK_DENSITY - 1.0) > 0.01:
+            bed_spec = spec(round(cmu_k10.BULK_DENSITY / phi, 1))
+            bed = prepare_bed(bed_spec, cache_dir=cache)
+        repose = soillab.repose_test(bed_spec, soillab.ReposeSpec(seeds=(0,)), cache_dir=cache)
+        row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour, "rolling_model": law,
+               "density": bed_spec.material.density, "packing_fraction": bed.packing_fraction,
+               "bulk_density": bed.packing_fraction * bed_spec.material.density, "repose_deg": repose.runs[0].angle}
+    plate_bed = spec(row["density"], box or soil_lab.PLATE_BOX)
     measured = soillab.load_plate_curves()
     plates = {}
     for d in soil_lab.PLATE_DIAMETERS:
-        result = soillab.plate_test(bed_spec, soillab.PlateSpec(diameter=d), cache_dir=cache)
+        keep = {} if checkpoints is None else {
+            "checkpoint": checkpoints / f".{candidate_name(mu, mu_r, pour, law)}-plate{1e3 * d:g}.checkpoint.h5"}
+        result = soillab.plate_test(plate_bed, soillab.PlateSpec(diameter=d), cache_dir=cache, **keep)
         z = np.array(SINKAGES)
         sim, _, _ = soillab.mean_curve([result.curve], z)
         mea, mea_sd, _ = soillab.mean_curve([c for c in measured if c.size == d], z)
         area = result.curve.area
         plates[str(d)] = {"sinkage_m": list(z), "simulated_Pa": list(sim / area), "measured_Pa": list(mea / area),
                           "measured_sd_Pa": list(mea_sd / area), "wall_seconds": result.wall_seconds,
-                          "top_offset_m": result.top_offset, "inertial_number": result.inertial_number}
-    row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour, "rolling_model": law,
-           "density": bed_spec.material.density, "packing_fraction":
-           bed.packing_fraction, "bulk_density": bed.packing_fraction * bed_spec.material.density,
-           "repose_deg": repose.runs[0].angle, "plates": plates}
-    if shear:
+                          "top_offset_m": result.top_offset, "inertial_number": result.inertial_number,
+                          "bulk_density": result.bulk_density}
+    row["plates"] = plates
+    row["plate_box_m"] = [plate_bed.length, plate_bed.width, plate_bed.depth]
+    if shear and reused is None:
         result = soillab.shear_test(bed_spec, soillab.ShearSpec(), cache_dir=cache)
         row["shear"] = {"normal_stress_Pa": [r.plane_normal for r in result.runs],
                         "peak_shear_Pa": [r.peak for r in result.runs],
@@ -150,7 +186,13 @@ def run(args) -> int:
             print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
             return summary(args)
         ran += 1
-        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law)
+        name = candidate_name(mu, mu_r, pour, law)
+        reused = reused_row(args.reuse, name) if args.reuse else None
+        if args.reuse and reused is None:
+            raise SystemExit(f"--reuse: no folder of {args.reuse} has candidates/{name}.json")
+        box = dict(zip(("length", "width", "depth"), args.box)) if args.box else None
+        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law, box=box, reused=reused,
+                        checkpoints=out / "candidates" if args.box else None)
         tmp = path.with_suffix(".partial")
         tmp.write_text(json.dumps(row, indent=1))
         tmp.replace(path)
@@ -202,6 +244,12 @@ def main(argv=None) -> int:
     p.add_argument("--resume", action="store_true")
     p.add_argument("--cache", default=None)
     p.add_argument("--max-candidates", type=int, default=None, help="run at most this many (a session's share)")
+    p.add_argument("--box", type=float, nargs=3, default=None, metavar=("LENGTH", "WIDTH", "DEPTH"),
+                   help="the plates' box [m] (default the lab's 0.3 x 0.3 x 0.12 m); an interrupted plate continues "
+                        "from its checkpoint")
+    p.add_argument("--reuse", nargs="+", default=None, metavar="DIR",
+                   help="earlier calibration folders whose candidate files give each candidate's density, repose and "
+                        "shear box: only the plates run again (in --box)")
     p.set_defaults(func=run)
     p = sub.add_parser("summary")
     p.add_argument("out", nargs="?", default="docs/soillab/calibration")

@@ -94,3 +94,52 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
     lines = table.markdown(records)
     assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
     assert "**no**" in lines[3]
+
+
+def test_a_calibration_candidate_reruns_only_its_plates_in_another_box(tmp_path, monkeypatch, measured_dir):
+    """docs/soillab_calibration.py --box --reuse: a candidate keeps the density, repose and shear box of its earlier
+    file and presses its plates, and nothing else, in the box given, on the bed of that density (the DEM replaced
+    here by a power-law plate)."""
+    from types import SimpleNamespace
+
+    from wheelsoil import soillab
+    from wheelsoil.parameters import soil_lab
+    from wheelsoil.soillab.measured import LoadCurve
+
+    calibration = _load("soillab_calibration")
+    earlier = tmp_path / "earlier" / "candidates"
+    earlier.mkdir(parents=True)
+    old = {"friction": 0.5, "rolling_friction": 0.1, "pour_friction_factor": 1.0, "rolling_model": "epsd",
+           "density": 2345.0, "packing_fraction": 0.567, "bulk_density": 1329.6, "repose_deg": 27.0,
+           "shear": {"peak_friction_angle_deg": 40.0}, "plates": {"0.1": "stale"}, "objective": 9.9}
+    (earlier / "mu0.5_mur0.1_epsd.json").write_text(json.dumps(old))
+    assert calibration.reused_row([tmp_path / "nowhere", tmp_path / "earlier"], "mu0.3_mur0.1_epsd") is None
+    reused = calibration.reused_row([tmp_path / "earlier"], "mu0.5_mur0.1_epsd")
+    assert "plates" not in reused and "objective" not in reused and reused["density"] == 2345.0
+
+    pressed = []
+
+    def plate_test(bed, plate, cache_dir=None, checkpoint=None):
+        pressed.append((bed, plate.diameter, checkpoint))
+        z = np.linspace(0.0, 0.03, 61)
+        area = np.pi * plate.diameter ** 2 / 4
+        curve = LoadCurve("plate", plate.diameter, "fake", z, area * 2e6 * z ** 1.2, area=area)
+        return SimpleNamespace(curve=curve, wall_seconds=1.0, top_offset=0.0, inertial_number=1e-4,
+                               bulk_density=1330.0)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a reused candidate runs no bed preparation, repose or shear box")
+
+    monkeypatch.setattr(soillab, "plate_test", plate_test)
+    for name in ("repose_test", "shear_test"):
+        monkeypatch.setattr(soillab, name, refuse)
+    monkeypatch.setattr("wheelsoil.granular.bed.prepare_bed", refuse)
+    box = {"length": 0.6, "width": 0.6, "depth": 0.12}
+    row = calibration.candidate(0.5, 0.1, None, shear=True, law="epsd", box=box, reused=reused,
+                                checkpoints=tmp_path / "ck")
+    assert [d for _, d, _ in pressed] == list(soil_lab.PLATE_DIAMETERS)
+    for bed, d, checkpoint in pressed:
+        assert (bed.length, bed.width, bed.depth) == (0.6, 0.6, 0.12) and bed.material.density == 2345.0
+        assert checkpoint.parent == tmp_path / "ck" and f"{1e3 * d:g}" in checkpoint.name
+    assert row["repose_deg"] == 27.0 and row["shear"] == old["shear"] and row["plate_box_m"] == [0.6, 0.6, 0.12]
+    assert np.isfinite(row["objective"]) and row["objective"] != old["objective"]
