@@ -143,3 +143,41 @@ def test_a_calibration_candidate_reruns_only_its_plates_in_another_box(tmp_path,
         assert checkpoint.parent == tmp_path / "ck" and f"{1e3 * d:g}" in checkpoint.name
     assert row["repose_deg"] == 27.0 and row["shear"] == old["shear"] and row["plate_box_m"] == [0.6, 0.6, 0.12]
     assert np.isfinite(row["objective"]) and row["objective"] != old["objective"]
+
+
+def test_seed004_like_reads_changes_in_the_seeds_terms(tmp_path):
+    """docs/seed004_like.py on synthetic runs whose drawbar pull falls by a known 40 % from 5 to 20 deg at every
+    slip, and is 80 % lower at 1/6 g: it gives those averages, leaves out slips whose runs are not steady and reports
+    nothing below four slips."""
+    table = _load("seed004_like")
+    cases = tmp_path / "cases"
+    k = 0
+    for gravity, load in (table.EARTH_3000, table.MOON_500):
+        for angle in (5.0, 20.0):
+            for slip in table.SLIPS:
+                dp = 1000.0 * slip * (0.6 if angle == 20.0 else 1.0) * (0.2 if gravity == "moon" else 1.0)
+                steady = not (gravity == "moon" and slip >= 0.4)  # three moon slips are not steady
+                folder = cases / f"c{k}"
+                folder.mkdir(parents=True)
+                k += 1
+                folder.joinpath("case.toml").write_text(
+                    f'[soil]\ngravity = "{gravity}"\n[test]\nload = {load}\nslip_angle = {angle}\nslip = {slip}\n')
+                q = {"drawbar_pull": {"mean": dp, "sem": 5.0}, "lateral_force": {"mean": -dp, "sem": 5.0},
+                     "sinkage": {"mean": 0.05, "sem": 1e-3}}
+                folder.joinpath("summary.json").write_text(json.dumps({"summary": {"steady": steady, **q}}))
+    runs = table.read_runs(tmp_path)
+    factors = {"earth": dict.fromkeys(table.QUANTITIES, 2.0), "moon": dict.fromkeys(table.QUANTITIES, 1.0)}
+    steer = table.averaged(runs, factors, (*table.EARTH_3000, 5.0), (*table.EARTH_3000, 20.0), "drawbar_pull",
+                           difference=False)
+    assert steer["value"] == pytest.approx(-40.0) and steer["slips"] == list(table.SLIPS)
+    # the error: each slip's change from sems of 5 N widened twice, averaged over six slips
+    one = [100 * np.hypot(10 / (1000 * s), 600 * s * 10 / (1000 * s) ** 2) for s in table.SLIPS]
+    assert steer["error"] == pytest.approx(np.sqrt(np.sum(np.square(one))) / 6)
+    lateral = table.averaged(runs, factors, (*table.EARTH_3000, 5.0), (*table.EARTH_3000, 20.0), "lateral_force",
+                             difference=False)
+    assert lateral["value"] == pytest.approx(-40.0)  # by magnitude
+    gravity = table.averaged(runs, factors, (*table.EARTH_3000, 20.0), (*table.MOON_500, 20.0), "drawbar_pull",
+                             difference=True)
+    assert np.isnan(gravity["value"]) and gravity["slips"] == [0.1, 0.2, 0.3]
+    assert table.verdict(-36.9, steer) in ("agrees", "the same way") and table.verdict(80.0, gravity).startswith("not")
+    assert table.verdict(+30.0, {"value": -40.0, "error": 1.0, "slips": []}) == "disagrees"
