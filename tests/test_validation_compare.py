@@ -140,3 +140,28 @@ def test_a_run_without_a_steady_state_is_left_out_and_named(tmp_path):
     table.to_csv(tmp_path / "sweep" / "summary.csv", index=False)
     with pytest.raises(WheelsoilInputError, match="none of its 18 runs reached a steady state"):
         load_sweep_summary(tmp_path / "sweep")
+
+
+def test_a_run_that_twins_no_measured_condition_is_refused_unless_allowed(tmp_path, capsys):
+    """validate --model: a run at a load no trial has (a typo in a twin's sweep) is refused before any report,
+    named with its conditions; a second run of a measured condition (a replica) is not an orphan;
+    --allow-unpaired-runs leaves the orphan out."""
+    from wheelsoil.cases.cli import EXIT_OK, main
+    from wheelsoil.validation.compare import unpaired_runs
+    from wheelsoil.validation.measured import save_measurements
+
+    measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    csv = save_measurements(measured, tmp_path / "measured.csv")
+    rows = np.r_[np.arange(len(measured)), 0]  # every condition, the first twice
+    sim = _as_sweep_summary(measured, tmp_path / "sweep", rows=rows)
+    assert unpaired_runs(measured, sim).size == 0
+    table = pd.read_csv(tmp_path / "sweep" / "summary.csv")
+    table.loc[3, "load_set"] = 97.0  # no trial at 97 N
+    table.to_csv(tmp_path / "sweep" / "summary.csv", index=False)
+    out = tmp_path / "rep"
+    assert main(["validate", str(csv), "--model", str(tmp_path / "sweep"), "--report", str(out)]) != EXIT_OK
+    err = capsys.readouterr().err
+    assert "1 of the 19 runs" in err and "run 3:" in err and "load 97 N" in err and not (out / "report.md").exists()
+    assert main(["validate", str(csv), "--model", str(tmp_path / "sweep"), "--report", str(out),
+                 "--allow-unpaired-runs"]) == EXIT_OK
+    assert (out / "report.md").is_file()

@@ -67,6 +67,35 @@ def match_conditions(data: Measurements, simulated: Measurements) -> tuple[np.nd
     return np.array(pairs, int).reshape(-1, 2), np.array(unmatched, int)
 
 
+def unpaired_runs(data: Measurements, simulated: Measurements) -> np.ndarray:
+    """The simulated rows that match no measured row at all (a replica of a measured condition is paired)."""
+    out = []
+    for j in range(len(simulated)):
+        ok = np.ones(len(data), bool)
+        for key in MATCH:
+            ok &= _same(key, np.asarray(getattr(data, key), float), float(getattr(simulated, key)[j]))
+        if not ok.any():
+            out.append(j)
+    return np.array(out, int)
+
+
+def check_every_run_paired(data: Measurements, simulated: Measurements) -> None:
+    """Refuse a simulated run that twins no measured condition, naming its conditions: a run meant to twin a trial
+    at a slip, slip angle or load typed wrong would otherwise be left out without a word."""
+    orphans = unpaired_runs(data, simulated)
+    if orphans.size == 0:
+        return
+    shown = "; ".join(
+        f"run {j}: slip {simulated.slip[j]:.4g}, slip_angle {simulated.slip_angle[j]:g} deg, load "
+        f"{simulated.load[j]:.5g} N, gravity {simulated.gravity[j]:.4g} m/s^2, wheel r {simulated.radius[j]:g} m"
+        for j in orphans[:5])
+    raise WheelsoilInputError(
+        f"{len(orphans)} of the {len(simulated)} runs in {simulated.name} twin no measured condition of {data.name} "
+        f"(matched on {', '.join(MATCH)} within {', '.join(f'{k} {t:g}' for k, (_, t) in MATCH.items())}): "
+        f"{shown}{' ...' if orphans.size > 5 else ''}; fix the runs' conditions, or pass --allow-unpaired-runs to "
+        "leave them out")
+
+
 def _levels(values, digits: int) -> list:
     return sorted({round(float(v), digits) for v in values})
 

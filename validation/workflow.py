@@ -182,10 +182,11 @@ def predict_command(model_path: str, data_arg: str, *, out: Path, group: str | N
 
 
 def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, responses=None, group: str | None = None,
-                                command: str = "") -> dict:
+                                command: str = "", allow_unpaired: bool = False) -> dict:
     """``wheelsoil validate DATA --model SWEEP``: the DEM--FEM runs of a sweep as the model, compared with the
-    measured data condition by condition (:mod:`.compare`)."""
-    from .compare import compare, write_comparison_report
+    measured data condition by condition (:mod:`.compare`). A run that twins no measured condition is refused
+    (:func:`.compare.check_every_run_paired`) unless ``allow_unpaired``."""
+    from .compare import check_every_run_paired, compare, write_comparison_report
     from .measured import load_sweep_summary
 
     if data_arg in ("synthetic", "synthetic-periodic"):
@@ -194,6 +195,8 @@ def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, 
     data = load_measurements(data_arg)
     data = select_group(data, group)
     simulated = load_sweep_summary(model_arg)
+    if not allow_unpaired:
+        check_every_run_paired(data, simulated)
     return write_comparison_report(compare(data, simulated, responses), data, simulated, report, command=command)
 
 
@@ -204,7 +207,8 @@ def main_validate(args) -> int:
     command = "wheelsoil " + " ".join(getattr(args, "argv", None) or sys.argv[1:])
     if getattr(args, "model", "semi-empirical") != "semi-empirical":
         f = validate_against_simulation(args.data, args.model, report=args.report, responses=args.responses,
-                                        group=args.group, command=command)
+                                        group=args.group, command=command,
+                                        allow_unpaired=getattr(args, "allow_unpaired_runs", False))
         console.print(f"{f['pairs']} measured conditions paired with a simulated run ({f['unmatched']} without)")
         for q, v in f["responses"].items():
             console.print(f"  {q:14s} bias/spread {v['nbias']:+.3f}  RMS/spread {v['nrmse']:.3f}")

@@ -36,6 +36,8 @@ def add_parser(sub) -> None:
                    help="model to hold against the data: 'semi-empirical' (default: the terramechanics model, "
                         "calibrated, with the candidate mechanisms) or a wheelsoil sweep folder / summary.csv (the "
                         "DEM-FEM runs, compared with the measured data condition by condition)")
+    p.add_argument("--allow-unpaired-runs", action="store_true",
+                   help="with --model: leave out runs that twin no measured condition instead of refusing them")
     p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")
     p.add_argument("--holdout", default=None,
                    help="CONDITION=VALUE: hold out one level, e.g. slip_angle=45 or group=smooth "
