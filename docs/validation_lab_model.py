@@ -22,7 +22,7 @@ the paired trials only, the same rows for each, and the twin's points are drawn 
 
 Usage (from the repository root; a few minutes on 2 cores)::
 
-    python docs/validation_lab_model.py --out docs/validation/lab-parameters [--twin SWEEP]
+    python docs/validation_lab_model.py --out docs/validation/lab-parameters [--twin SWEEP [SWEEP ...]]
 """
 
 import argparse
@@ -90,13 +90,20 @@ def _unsupported(soil, data) -> np.ndarray:
     return out
 
 
-def three_models(data, preds: dict, scales: dict, sweep: str) -> tuple[dict, list[str]]:
-    """The DEM--FEM twin's steady runs of ``sweep`` paired with the measured rows, and the three models' bias and
-    RMS error on those rows (normalised by the responses' measured spread), as Markdown lines."""
+def three_models(data, preds: dict, scales: dict, sweeps) -> tuple[dict, list[str]]:
+    """The DEM--FEM twin's steady runs of ``sweeps`` (one folder or several, their runs one after another) paired
+    with the measured rows, and the three models' bias and RMS error on those rows (normalised by the responses'
+    measured spread), as Markdown lines."""
+    from wheelsoil.validation.candidate_test import concat_runs
     from wheelsoil.validation.compare import compare
     from wheelsoil.validation.measured import load_sweep_summary
 
-    simulated = load_sweep_summary(sweep)
+    sweeps = [sweeps] if isinstance(sweeps, (str, Path)) else list(sweeps)
+    parts = [load_sweep_summary(s) for s in sweeps]
+    simulated = parts[0] if len(parts) == 1 else concat_runs(" + ".join(str(s) for s in sweeps), parts)
+    if len(parts) > 1:
+        simulated.notes = "; ".join(p.notes for p in parts)
+    sweep = " + ".join(str(s) for s in sweeps)
     paired = compare(data, simulated, RESPONSES)  # the pairs and the twin's share within two combined std
     rows, runs = paired.pairs[:, 0], paired.pairs[:, 1]
     twin = {"sweep": str(sweep), "notes": simulated.notes, "paired": int(len(rows)), "measured_rows": rows,
@@ -135,7 +142,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="docs/validation/lab-parameters")
     ap.add_argument("--data", default=str(MEASURED))
-    ap.add_argument("--twin", default=None, help="a sweep folder of the CMU rig presets: the DEM-FEM twin")
+    ap.add_argument("--twin", nargs="+", default=None,
+                    help="sweep folders of the CMU rig presets (their steady runs together): the DEM-FEM twin")
     args = ap.parse_args(argv)
 
     from wheelsoil.parameters import cmu_sand
