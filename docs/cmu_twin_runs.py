@@ -50,7 +50,8 @@ def finished_runs(runs: Path) -> list[dict]:
             s = summary["summary"]
             record = {"sweep": sweep.name, "case_hash": folder.name, "wheel": case["wheel"]["preset"],
                       "seed": case["case"]["seed"], "slip": case["test"]["slip"],
-                      "slip_angle": case["test"]["slip_angle"], "load": case["test"]["load"], "drive_time": case["test"]["drive_time"],
+                      "slip_angle": case["test"]["slip_angle"], "load": case["test"]["load"],
+                      "drive_time": case["test"]["drive_time"],
                       "bin": [case["soil"]["length"], case["soil"]["width"], case["soil"]["depth"]],
                       "steady": bool(s["steady"]), "window": s["window"], "reasons": s.get("reasons", []),
                       "wall_seconds": summary["run"].get("wall_seconds"),
@@ -103,7 +104,8 @@ def markdown(records: list[dict]) -> list[str]:
         wheel = r["wheel"].replace("cmu-k10-", "")
         bin_note = "" if r["bin"] == [0.3, 0.2, 0.1] else f", bin {r['bin'][1]:g} × {r['bin'][2]:g} m"
         lines.append(f"| {r['sweep'].replace('cmu-', '')} | {wheel}, {r['slip_angle']:g}°, {r['slip']:+.3f}, "
-                     f"{r['load']:.2f} N, seed {r['seed']}, {r['drive_time']:g} s drive{bin_note} | {steady} | " + " | ".join(cells) +
+                     f"{r['load']:.2f} N, seed {r['seed']}, {r['drive_time']:g} s drive{bin_note} | {steady} | "
+                     + " | ".join(cells) +
                      f" | {r['wall_seconds']:.0f} s / {r['simulated_seconds']:.2f} s |")
     return lines
 

@@ -82,7 +82,8 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
         folder.joinpath("case.toml").write_text(
             f'[case]\nseed = 1\n[soil]\nlength = 0.3\nwidth = 0.2\ndepth = 0.1\n[wheel]\npreset = "cmu-k10-grouser"\n'
             f'[test]\nslip = {data.travel_slip[k]}\nslip_angle = 45.0\nload = {data.load[k]}\ndrive_time = 20.0\n')
-        summary = {"steady": steady, "window": [2.0, 9.0], "tread_slip": {"mean": 0.5}, "vertical_force": {"mean": 20.0},
+        summary = {"steady": steady, "window": [2.0, 9.0], "tread_slip": {"mean": 0.5},
+                   "vertical_force": {"mean": 20.0},
                    "drawbar_pull": quantity(data.responses["drawbar_pull"][k] + 2 * data.std["drawbar_pull"][k]),
                    "lateral_force": quantity(-1.0), "tread_sinkage": quantity(0.03)}
         folder.joinpath("summary.json").write_text(json.dumps(

@@ -72,9 +72,10 @@ def add_parser(sub) -> None:
     parser.add_argument("--progress", action="store_true", help="progress bars on the terminal")
     parser.add_argument("--checkpoint-every", type=int, default=None, metavar="SAMPLES",
                         help="plate, wheel: keep the state every SAMPLES samples in OUT/.TEST-...checkpoint.h5, so "
-                             "that the same command run again after an interruption continues the test from there (a test "
-                             "already finished in that command is run again); the same SAMPLES gives the same curve, "
-                             "interrupted or not, and another than a run without checkpoints (default: none)")
+                             "that the same command run again after an interruption continues the test from there "
+                             "(a test already finished in that command is run again); the same SAMPLES gives the "
+                             "same curve, interrupted or not, and another than a run without checkpoints "
+                             "(default: none)")
     common.add_arch_option(parser)
     parser.set_defaults(func=run)
 
