@@ -165,3 +165,25 @@ def test_a_run_that_twins_no_measured_condition_is_refused_unless_allowed(tmp_pa
     assert main(["validate", str(csv), "--model", str(tmp_path / "sweep"), "--report", str(out),
                  "--allow-unpaired-runs"]) == EXIT_OK
     assert (out / "report.md").is_file()
+
+
+def test_at_90_degrees_a_run_pairs_only_with_the_trial_at_its_travel_slip(measured_dir):
+    """At 90 deg the heading slip is +-1 at every rim speed, so a twin run of the CMU grousered wheel driving at travel
+    slip 0.5 must pair with the trial at 0.5 and not with one at free rolling whose load happens to be within 1 %."""
+    from pathlib import Path
+
+    from wheelsoil.validation.compare import match_conditions
+    from wheelsoil.validation.measured import load_cmu_trials
+
+    data = load_cmu_trials(Path(measured_dir) / "cmu_3d_terramechanics")
+    at90 = np.flatnonzero((data.grouser_height > 0) & (data.slip_angle == 90.0))
+    assert len(np.unique(data.slip[at90])) <= 3  # the heading slip cannot tell the trials apart
+    k = int(at90[np.argmin(np.abs(data.travel_slip[at90] - 0.5))])
+    sim = data.select(np.arange(len(data)) == k)
+    for other in at90[np.abs(data.travel_slip[at90] - 0.5) > 0.05]:  # the other 90 deg trials, at this run's load
+        probe = data.select(np.arange(len(data)) == other)
+        probe.load = sim.load.copy()
+        pairs, _ = match_conditions(probe, sim)
+        assert len(pairs) == 0, f"trial at travel slip {data.travel_slip[other]:.3f} paired with the run at 0.5"
+    pairs, _ = match_conditions(data, sim)
+    assert k in pairs[:, 0] and np.all(np.abs(data.travel_slip[pairs[:, 0]] - data.travel_slip[k]) <= 0.01)

@@ -52,14 +52,24 @@ class Comparison:
         return [t for t in self.trends if t["p_value"] < TREND_P]
 
 
+def same_conditions(ref: Measurements, other: Measurements, j: int) -> np.ndarray:
+    """The rows of ``ref`` at the conditions of row ``j`` of ``other``: every :data:`MATCH` key within its tolerance,
+    and the travel slip (the rig's) within the slip's where both sets give it. At 90 deg the heading slip is +-1
+    whatever the wheel's speed (``wheelsoil.slip``), so there only the travel slip tells one slip from another."""
+    ok = np.ones(len(ref), bool)
+    for key in MATCH:
+        ok &= _same(key, np.asarray(getattr(ref, key), float), float(getattr(other, key)[j]))
+    if ref.travel_slip is not None and other.travel_slip is not None:
+        ok &= np.abs(np.asarray(ref.travel_slip, float) - float(other.travel_slip[j])) <= MATCH["slip"][1]
+    return ok
+
+
 def match_conditions(data: Measurements, simulated: Measurements) -> tuple[np.ndarray, np.ndarray]:
-    """(pairs, unmatched): each measured row paired with the first simulated row at its conditions."""
+    """(pairs, unmatched): each measured row paired with the first simulated row at its conditions
+    (:func:`same_conditions`)."""
     pairs, unmatched = [], []
     for k in range(len(data)):
-        ok = np.ones(len(simulated), bool)
-        for key in MATCH:
-            ok &= _same(key, np.asarray(getattr(simulated, key), float), float(getattr(data, key)[k]))
-        hit = np.flatnonzero(ok)
+        hit = np.flatnonzero(same_conditions(simulated, data, k))
         if hit.size:
             pairs.append((k, int(hit[0])))
         else:
@@ -69,14 +79,7 @@ def match_conditions(data: Measurements, simulated: Measurements) -> tuple[np.nd
 
 def unpaired_runs(data: Measurements, simulated: Measurements) -> np.ndarray:
     """The simulated rows that match no measured row at all (a replica of a measured condition is paired)."""
-    out = []
-    for j in range(len(simulated)):
-        ok = np.ones(len(data), bool)
-        for key in MATCH:
-            ok &= _same(key, np.asarray(getattr(data, key), float), float(getattr(simulated, key)[j]))
-        if not ok.any():
-            out.append(j)
-    return np.array(out, int)
+    return np.array([j for j in range(len(simulated)) if not same_conditions(data, simulated, j).any()], int)
 
 
 def check_every_run_paired(data: Measurements, simulated: Measurements) -> None:
