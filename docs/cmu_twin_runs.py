@@ -38,12 +38,12 @@ QUANTITIES = {"drawbar_pull": ("drawbar_pull", "drawbar pull", 1.0, "N"),
 
 def finished_runs(runs: Path) -> list[dict]:
     """One record per finished case of every ``runs/cmu-*`` sweep folder (sorted by sweep and case hash); a case
-    folder linked from another sweep (a convergence study's reference) is listed once, under its own sweep."""
+    folder linked from another sweep (a convergence study's reference) is listed under its own sweep only."""
     out, seen = [], set()
     for sweep in sorted(p for p in runs.glob("cmu-*") if p.is_dir()):
         for folder in sorted((sweep / "cases").glob("*")):
-            if not (folder / "summary.json").is_file() or folder.resolve() in seen:
-                continue
+            if folder.is_symlink() or not (folder / "summary.json").is_file() or folder.resolve() in seen:
+                continue  # a link (a convergence study's reference) is listed under the sweep it belongs to
             seen.add(folder.resolve())
             case = tomllib.loads((folder / "case.toml").read_text())
             summary = json.loads((folder / "summary.json").read_text())
