@@ -21,7 +21,6 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-
 from wheelsoil.awake import keep_cores_awake, requested_by_environment
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.provenance import atomic_output, provenance, writable_folder

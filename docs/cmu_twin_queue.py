@@ -1,6 +1,6 @@
 """The CMU twin's runs, one case at a time, in the order a queue file gives (issue 34; docs/cmu-twin/README.md).
 
-The sweeps' cases take up to 80 minutes each on 2 cores, so they run one at a time in an order chosen for what each
+The sweeps' cases take one to several hours each on 2 cores, so they run one at a time in an order chosen for what each
 finished case lets be judged (the README's "Queue order"), not the sweeps' own order. The queue is a JSON list, read
 again before each entry (so it can be reordered while a case runs), with entries of two kinds:
 

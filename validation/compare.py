@@ -94,7 +94,8 @@ def check_every_run_paired(data: Measurements, simulated: Measurements) -> None:
         for j in orphans[:5])
     raise WheelsoilInputError(
         f"{len(orphans)} of the {len(simulated)} runs in {simulated.name} twin no measured condition of {data.name} "
-        f"(matched on {', '.join(MATCH)} within {', '.join(f'{k} {t:g}' for k, (_, t) in MATCH.items())}): "
+        f"(matched on {', '.join(MATCH)} within {', '.join(f'{k} {t:g}' for k, (_, t) in MATCH.items())}, and the "
+        "travel slip where both give it): "
         f"{shown}{' ...' if orphans.size > 5 else ''}; fix the runs' conditions, or pass --allow-unpaired-runs to "
         "leave them out")
 
