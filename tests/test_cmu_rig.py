@@ -108,7 +108,9 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
         grouser_height=np.array([g.grouser_height if g.grouser_count else 0.0 for g in geometry]),
         grouser_count=np.array([g.grouser_count for g in geometry], float), group=np.full(n, "1g"),
         responses={q: np.full(n, np.nan) for q in ("drawbar_pull", "lateral_force", "sinkage", "torque")},
-        std={}, notes="conditions only")
+        std={}, notes="conditions only",
+        # and its travel slip kept, as load_sweep_summary keeps it: at 90 deg only the travel slip tells the trials apart
+        travel_slip=np.array([c.case.test.slip for c in full.cases]))
     data = load_cmu_trials(folder)
     pairs, unmatched = match_conditions(data, simulated)
     assert len(data) == 297 and unmatched.size == 0 and len(pairs) == 297
