@@ -182,3 +182,25 @@ def test_seed004_like_reads_changes_in_the_seeds_terms(tmp_path):
     assert np.isnan(gravity["value"]) and gravity["slips"] == [0.1, 0.2, 0.3]
     assert table.verdict(-36.9, steer) in ("agrees", "the same way") and table.verdict(80.0, gravity).startswith("not")
     assert table.verdict(+30.0, {"value": -40.0, "error": 1.0, "slips": []}) == "disagrees"
+
+
+def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
+    """docs/soillab_box_check.py: a doubling that moves the plate's pressure by 5 % passes, one by 20 % fails, and a
+    box not yet run is said to be missing."""
+    check = _load("soillab_box_check")
+
+    def box(name, scale):
+        (tmp_path / name).mkdir()
+        rows = [{"diameter_m": 0.1, "sinkage_m": z, "simulated_Pa": 1e6 * z * scale}
+                for z in (0.005, 0.01, 0.015, 0.02)]
+        rows.append({"diameter_m": 0.06, "sinkage_m": 0.01, "simulated_Pa": 1.0})  # another plate: not read
+        (tmp_path / name / "plate.json").write_text(json.dumps({"pressure": rows}))
+
+    box("lab", 1.0)
+    box("wide", 1 / 0.95)  # the wide box's pressure 5 % above: passes
+    box("deep", 1.25)      # 20 % of the deep box's: fails
+    assert check.main(["--boxes", str(tmp_path)]) == 0
+    verdicts = json.loads((tmp_path / "check.json").read_text())
+    assert [v["verdict"] for v in verdicts][:2] == ["passes", "fails (20% against 10%)"]
+    assert verdicts[0]["changes"] == pytest.approx([0.05] * 3)
+    assert verdicts[2]["verdict"] == verdicts[3]["verdict"] == "not run yet"
