@@ -22,7 +22,8 @@ is 45 deg at 5--20 kPa.
 The lab's 0.3 x 0.3 m box is too small for the 100 mm plate (docs/soillab/README.md, "The box check", 2026-11-28):
 doubled across, the same soil carries 13.4 / 18.1 / 23.0 kPa at 10 / 15 / 20 mm, 32--38 % less than in the lab's
 box (a change of 47--61 % of the wider box's value), and 26--31 % softer than the sand below 10 mm; doubled in depth it
-carries 18--32 % more (25.3 / 35.1 / 44.8 kPa). The calibration above matched the plates in the small box, so it
+carries 18--32 % more (25.3 / 35.1 / 44.8 kPa), and the wide box doubled in depth 32--37 % more than the wide box
+(the deeper pour packs denser, 0.529 against 0.522). The calibration above matched the plates in the small box, so it
 carries that bias until it is run again in a box that passes the doubling check.
 
 The particles are coarser than sand grains: the calibration ran on 6.4--9.6 mm spheres; the CMU wheels (50 mm
