@@ -175,6 +175,11 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
 
 def run(args) -> int:
     out = Path(args.out)
+    if args.reuse:  # every candidate's earlier file, checked before hours of plates
+        missing = [candidate_name(mu, mu_r, pour, law) for mu, mu_r, pour, _, law in DESIGNS[args.design]
+                   if reused_row(args.reuse, candidate_name(mu, mu_r, pour, law)) is None]
+        if missing:
+            raise SystemExit(f"--reuse {' '.join(args.reuse)}: no candidates/<name>.json for {', '.join(missing)}")
     (out / "candidates").mkdir(parents=True, exist_ok=True)
     ran = 0
     for mu, mu_r, pour, shear, law in DESIGNS[args.design]:
@@ -188,8 +193,6 @@ def run(args) -> int:
         ran += 1
         name = candidate_name(mu, mu_r, pour, law)
         reused = reused_row(args.reuse, name) if args.reuse else None
-        if args.reuse and reused is None:
-            raise SystemExit(f"--reuse: no folder of {args.reuse} has candidates/{name}.json")
         box = dict(zip(("length", "width", "depth"), args.box)) if args.box else None
         row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law, box=box, reused=reused,
                         checkpoints=out / "candidates" if args.box else None)
