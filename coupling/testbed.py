@@ -64,6 +64,7 @@ from wheelsoil.flexwheel.structure import Structure
 from wheelsoil.granular.bed import Bed
 
 from .contact import WheelContact
+from .coupled_state import restore_coupled_state, take_coupled_state
 from .kinematics import TreadTracker, deformation, rig_command, yaw_matrix
 from .patch import MovingPatch
 from .placement import wheel_start_centre
@@ -287,8 +288,7 @@ class Testbed:
         """
         if self._loop is None or self._loop.phase == "done":
             raise WheelsoilInputError("a testbed state can only be taken during a run (from on_sample)")
-        state = {"scene": self.scene.state(), "structure": self.structure.state(), "contact": self.contact.state()}
-        self.contact.invalidate()
+        state = take_coupled_state(self.scene, self.structure, self.contact)
         state["testbed"] = {"loop": self._loop.to_dict(), "rows": {k: np.asarray(v, float) for k, v in self.rows.items()}}
         if self.patch is not None:
             state["patch"] = self.patch.state()
@@ -299,9 +299,7 @@ class Testbed:
         rows = state["testbed"]["rows"]
         if set(rows) != set(SERIES_UNITS):
             raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
-        self.scene.restore_state(state["scene"], same_spheres=self.patch is None)
-        self.structure.restore_state(state["structure"])
-        self.contact.restore_state(self.scene, state["contact"])
+        restore_coupled_state(state, self.scene, self.structure, self.contact, same_spheres=self.patch is None)
         if self.patch is not None:
             self.patch.restore_state(state["patch"])
         self._loop = ProtocolState.from_dict(state["testbed"]["loop"])

@@ -175,12 +175,15 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
 
 def run(args) -> int:
     out = Path(args.out)
-    if args.reuse:  # every candidate's earlier file, checked before hours of plates
-        missing = [candidate_name(mu, mu_r, pour, law) for mu, mu_r, pour, _, law in DESIGNS[args.design]
-                   if reused_row(args.reuse, candidate_name(mu, mu_r, pour, law)) is None]
+    reused = {}
+    if args.reuse:  # every candidate's earlier file, read and checked before hours of plates
+        names = [candidate_name(mu, mu_r, pour, law) for mu, mu_r, pour, _, law in DESIGNS[args.design]]
+        reused = {name: reused_row(args.reuse, name) for name in names}
+        missing = [name for name, row in reused.items() if row is None]
         if missing:
             raise SystemExit(f"--reuse {' '.join(args.reuse)}: no candidates/<name>.json for {', '.join(missing)}")
     (out / "candidates").mkdir(parents=True, exist_ok=True)
+    box = dict(zip(("length", "width", "depth"), args.box)) if args.box else None
     ran = 0
     for mu, mu_r, pour, shear, law in DESIGNS[args.design]:
         path = out / "candidates" / f"{candidate_name(mu, mu_r, pour, law)}.json"
@@ -191,10 +194,8 @@ def run(args) -> int:
             print(f"stopping after {ran} candidate(s) (--max-candidates); --resume goes on", flush=True)
             return summary(args)
         ran += 1
-        name = candidate_name(mu, mu_r, pour, law)
-        reused = reused_row(args.reuse, name) if args.reuse else None
-        box = dict(zip(("length", "width", "depth"), args.box)) if args.box else None
-        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law, box=box, reused=reused,
+        row = candidate(mu, mu_r, args.cache, pour=pour, shear=shear, law=law, box=box,
+                        reused=reused.get(candidate_name(mu, mu_r, pour, law)),
                         checkpoints=out / "candidates" if args.box else None)
         tmp = path.with_suffix(".partial")
         tmp.write_text(json.dumps(row, indent=1))

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wheelsoil.coupling.coupled_state import restore_coupled_state, take_coupled_state
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, build_wheel_mesh, from_parameters
 from wheelsoil.granular.bed import Bed, prepare_bed
@@ -105,9 +106,8 @@ def press_key(*parts) -> str:
 
 
 def _take_state(tool: RigidTool, sinkage: list, force: list) -> dict:
-    state = {"scene": tool.scene.state(), "structure": tool.structure.state(), "contact": tool.contact.state(),
-             "press": {"sinkage": np.asarray(sinkage, float), "force": np.asarray(force, float)}}
-    tool.contact.invalidate()  # as the restored run must, so both step alike from here
+    state = take_coupled_state(tool.scene, tool.structure, tool.contact)
+    state["press"] = {"sinkage": np.asarray(sinkage, float), "force": np.asarray(force, float)}
     return state
 
 
@@ -119,9 +119,7 @@ def _restore(tool: RigidTool, checkpoint: PressCheckpoint) -> tuple[list, list] 
     if meta.get("key") != checkpoint.key:
         raise WheelsoilInputError(f"{checkpoint.path} is the checkpoint of another test (key {meta.get('key')}, this "
                                   f"test {checkpoint.key}): remove it, or run the test it was written for")
-    tool.scene.restore_state(state["scene"])
-    tool.structure.restore_state(state["structure"])
-    tool.contact.restore_state(tool.scene, state["contact"])
+    restore_coupled_state(state, tool.scene, tool.structure, tool.contact)
     press = state["press"]
     return [float(v) for v in np.atleast_1d(press["sinkage"])], [float(v) for v in np.atleast_1d(press["force"])]
 

@@ -23,9 +23,7 @@ def test_the_docs_have_their_scripts():
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
 def test_a_docs_script_loads_and_its_wheelsoil_imports_exist(script, monkeypatch):
     monkeypatch.syspath_prepend(str(DOCS))  # the scripts import their siblings, as when run from the repository root
-    spec = importlib.util.spec_from_file_location(f"docs_{script.stem}", script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    _load(script.stem)
     for node in ast.walk(ast.parse(script.read_text(), filename=str(script))):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("wheelsoil"):
             target = importlib.import_module(node.module)
