@@ -6,7 +6,7 @@ parameter set (:mod:`wheelsoil.parameters.smoke`):
 
 * :func:`bed_spec` -- ``[soil]`` and ``case.seed`` -> :class:`~wheelsoil.granular.bed.BedSpec`;
 * :func:`wheel_geometry` -- ``[wheel]`` over its preset -> :class:`~wheelsoil.flexwheel.geometry.WheelGeometry`;
-* :func:`testbed_spec` -- ``[test]``, ``[contact]``, ``[output]``, ``soil.time_step`` and the wheel's
+* :func:`testbed_spec` -- ``[test]``, ``[contact]``, ``[output]``, ``[protocol]``, ``soil.time_step`` and the wheel's
   ``rigid``/``damping`` -> :class:`~wheelsoil.coupling.testbed.TestbedSpec`.
 
 :func:`plan` builds the three once, runs the solver's cross-checks on them (particles against the bin and the
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from wheelsoil.coupling.rig import RigPlan, TestbedSpec, plan_rig
+from wheelsoil.coupling.rig import DriveStage, RigPlan, TestbedSpec, plan_rig
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, estimated_elements, preset
 from wheelsoil.granular.bed_spec import BedSpec, estimated_particles
 from wheelsoil.material import Material, PairProperties
@@ -68,8 +68,8 @@ def wheel_geometry(case: CaseFile) -> WheelGeometry:
 
 
 def testbed_spec(case: CaseFile) -> TestbedSpec:
-    """What the rig does: the case's ``[test]``, ``[contact]`` and ``[output]`` sections, ``soil.time_step`` and
-    ``wheel.rigid``/``wheel.damping``."""
+    """What the rig does: the case's ``[test]``, ``[contact]`` and ``[output]`` sections, the further stages of its
+    drive (``[protocol]``), ``soil.time_step`` and ``wheel.rigid``/``wheel.damping``."""
     t, o, c = case.test, case.output, case.contact
     return TestbedSpec(
         slip=t.slip, slip_angle=t.slip_angle, slip_speed=t.slip_speed, load=t.load,
@@ -81,6 +81,7 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
         steady_checks=o.steady_checks, steady_drift_confidence=o.steady_drift_confidence, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
         damping=case.wheel.damping, axle_damping=t.axle_damping,
         pair=PairProperties(c.restitution, c.static_friction, c.rolling_friction, case.soil.rolling_model),
+        stages=tuple(DriveStage(st.slip, st.drive_time, st.ramp_time) for st in case.protocol.stages),
     )
 
 
@@ -120,9 +121,13 @@ class RunPlan:
 def output_bytes(case: CaseFile, particles: int, elements: int) -> int:
     """Upper estimate of a run's files [bytes]: its frames (at most one per sample; per particle position,
     velocity and radius, per wheel element about a node's position and deformation, 8 bytes each) over the
-    longest run (lowering allowed 2 s, settle, spin-up, the whole drive), plus two checkpoints."""
+    longest run (lowering allowed 2 s, settle, spin-up, the whole drive and every further stage's ramp and drive),
+    plus two checkpoints."""
     t, o = case.test, case.output
     total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
+    for st in case.protocol.stages:
+        total += (st.ramp_time if st.ramp_time is not None else t.spin_up_time) + (
+            st.drive_time if st.drive_time is not None else t.drive_time)
     frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
     per_frame = particles * 7 * 8 + elements * 6 * 8
     return frames * per_frame + 2 * particles * 30 * 8

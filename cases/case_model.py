@@ -13,7 +13,7 @@ from typing import Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
-from wheelsoil.coupling.rig import TestbedSpec
+from wheelsoil.coupling.rig import DriveStage, TestbedSpec
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.granular.bed_spec import BedSpec
@@ -41,7 +41,7 @@ def _q(default, unit: str, description: str, rng: Range | None = None):
     return Field(default, description=description, json_schema_extra={"unit": unit}, **limits)
 
 
-_TEST, _BED, _WHEEL = TestbedSpec.RANGES, BedSpec.RANGES, WheelGeometry.RANGES
+_TEST, _BED, _WHEEL, _STAGE = TestbedSpec.RANGES, BedSpec.RANGES, WheelGeometry.RANGES, DriveStage.RANGES
 _MATERIAL, _PAIR = Material.RANGES, PairProperties.RANGES
 _SOIL_MATERIAL, _SOIL_PAIR, _CONTACT = smoke.SOIL_MATERIAL, smoke.SOIL_SOIL, smoke.CONTACT
 
@@ -250,8 +250,27 @@ class Output(_Section):
     render: bool = Field(smoke.OUTPUT["render"], description="render the last state to final.png")
 
 
+class Stage(_Section):
+    """One further stage of the drive (``[protocol]`` ``stages``; :class:`~wheelsoil.coupling.rig.DriveStage`)."""
+
+    slip: float = _q(..., "1", "the stage's commanded slip (as test.slip)", _STAGE["slip"])
+    drive_time: Optional[float] = _q(None, "s", "the stage's longest drive after its ramp (default: test.drive_time)",
+                                     _STAGE["drive_time"])
+    ramp_time: Optional[float] = _q(None, "s", "time over which the hub's spin and the carriage's speed move from the "
+                                               "previous stage's command to this one's (default: test.spin_up_time)",
+                                    _STAGE["ramp_time"])
+
+
+class Protocol(_Section):
+    stages: tuple[Stage, ...] = Field(
+        (), description="further stages of the drive, after the first at test.slip, e.g. stages = [{slip = 0.3}, "
+                        "{slip = 0.5, drive_time = 6.0}]: each ramps to its slip, winds up and drives until steady "
+                        "(or for its drive_time), with its own summary (a slip ramp on one bed and one lowering)")
+
+
 SECTIONS: dict[str, type[_Section]] = {
     "case": CaseInfo, "soil": Soil, "wheel": Wheel, "contact": Contact, "test": Test, "output": Output,
+    "protocol": Protocol,
 }
 
 
@@ -266,6 +285,7 @@ class CaseFile(BaseModel):
     contact: Contact = Field(default_factory=Contact)
     test: Test = Field(default_factory=Test)
     output: Output = Field(default_factory=Output)
+    protocol: Protocol = Field(default_factory=Protocol)
 
     @property
     def name(self) -> str:
@@ -285,4 +305,6 @@ class CaseFile(BaseModel):
             data["soil"].pop("rolling_model")
         if data["output"]["steady_drift_confidence"] == 0.0:
             data["output"].pop("steady_drift_confidence")
+        if not data["protocol"]["stages"]:
+            data.pop("protocol")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -170,7 +170,8 @@ def render_testbed(result, path: str | Path, **kwargs) -> Path:
     tread = result.summary.tread_slip.mean
     verdict = "steady" if result.summary.steady else "NOT steady"
     kwargs.setdefault("title", f"end of the run, t = {result.info['simulated_seconds']:.2f} s ({verdict}): slip "
-                               f"{spec.slip:.2f} commanded, {tread:.3f} at the tread (window mean); steering "
+                               f"{result.summary.commanded_slip:.2f} commanded, {tread:.3f} at the tread (window "
+                               "mean); steering "
                                f"{spec.slip_angle:g} deg")
     kwargs.setdefault("arrows", motion_arrows(nodes, spec.slip_angle))
     if result.final_deformation is not None:
@@ -203,18 +204,23 @@ def result_box(result) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _result_kinematics(result) -> tuple[float, float]:
-    """(commanded slip, steering angle beta [deg]) of a result's case."""
+def _result_kinematics(result, t: float | None = None) -> tuple[float, float]:
+    """(commanded slip, steering angle beta [deg]) of a result's case; for a drive of several stages, the slip of the
+    stage running at time ``t`` [s] (the first whose steady window ends at or after ``t``)."""
     test = result.case.test
-    return float(test.slip), float(test.slip_angle)
+    slip = float(test.slip)
+    if t is not None and len(result.stages) > 1:
+        running = [st for st in result.stages if st.window[1] >= t]
+        slip = float((running[0] if running else result.stages[-1]).commanded_slip)
+    return slip, float(test.slip_angle)
 
 
 def frame_annotations(result, frame: dict) -> tuple[str, list]:
     """The title and arrows of a frame: commanded slip and steering angle, the slip the tread saw at that
     time (the ``tread_slip`` series, averaged over the last tenth of a second before the frame), and arrows
     for the wheel's heading (blue) and the carriage's travel (+X, red) from above the hub."""
-    slip, beta = _result_kinematics(result)
     t = float(frame["t"])
+    slip, beta = _result_kinematics(result, t)
     series = result.series
     recent = (series["t"] <= t) & (series["t"] > t - 0.1)
     tread = f"{float(np.mean(series['tread_slip'][recent])):.3f}" if recent.any() else "n/a"

@@ -12,6 +12,8 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
                       coupling.steady); window_start,
                       window_end [s], steady (bool), samples; + pitches (whole pitches of the tread in the
                       window), pitch_deg, commanded_slip, commanded_slip_angle, reasons (JSON list: why not steady)
+    /stages/<k>/      + only for a drive of several stages (``[[protocol.stages]]``, a slip ramp): attrs as
+                      /summary's, one group per stage in order (``000``, ``001``, ...); /summary is the last's
     /run              + attrs: wall time, step counts, sizes (coupling.testbed_result.TestbedResult.info)
     /mesh/            nodes0 (N, 3) [m] (wheel in its start pose), triangles (T, 3), beams (B, 2)
     /frames/<k>/      attr t [s]; particles/{position, velocity (float32), radius}, wheel/{nodes,
@@ -43,6 +45,7 @@ from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.state_file import attr_value
 
 FRAME_FORMAT = "{:06d}"
+STAGE_FORMAT = "{:03d}"
 #: The statistics a summary keeps for each steady quantity.
 SUMMARY_STATS = ("mean", "std", "sem", "ci95", "dof", "drift", "drift_sem", "zero_within_noise", "units")
 
@@ -123,23 +126,20 @@ class ResultWriter:
     def flush(self) -> None:
         self.file.flush()
 
-    def finish(self, series: dict, units: dict, summary: RunSummary, info: dict) -> Path:
-        """Write the series, summary and run info, mark complete, close and rename; returns the path."""
+    def finish(self, series: dict, units: dict, summary: RunSummary, info: dict,
+               stages: tuple[RunSummary, ...] = ()) -> Path:
+        """Write the series, summary (and, for a drive of several ``stages``, each stage's) and run info, mark
+        complete, close and rename; returns the path."""
         f = self.file
         s = f.create_group("series")
         for name, values in series.items():
             s.create_dataset(name, data=np.asarray(values, np.float64))
             s[name].attrs["units"] = units[name]
-        g = f.create_group("summary")
-        g.attrs["window_start"], g.attrs["window_end"] = summary.window
-        g.attrs["steady"] = bool(summary.steady)
-        g.attrs["samples"] = int(summary.samples)
-        for q, value in summary.to_dict().items():
-            if isinstance(value, dict):
-                for key, v in value.items():
-                    g.attrs[f"{q}_{key}"] = v
-            elif q not in ("window", "steady", "samples"):
-                g.attrs[q] = json.dumps(value) if isinstance(value, (list, tuple)) else value
+        _write_summary(f.create_group("summary"), summary)
+        if len(stages) > 1:
+            g = f.create_group("stages")
+            for k, stage in enumerate(stages):
+                _write_summary(g.create_group(STAGE_FORMAT.format(k)), stage)
         r = f.create_group("run")
         for key, value in info.items():
             r.attrs[key] = value
@@ -155,6 +155,31 @@ class ResultWriter:
             self.file.close()
 
 
+def _write_summary(g: h5py.Group, summary: RunSummary) -> None:
+    """A summary as the ``summary`` group's attributes (module docstring)."""
+    g.attrs["window_start"], g.attrs["window_end"] = summary.window
+    g.attrs["steady"] = bool(summary.steady)
+    g.attrs["samples"] = int(summary.samples)
+    for q, value in summary.to_dict().items():
+        if isinstance(value, dict):
+            for key, v in value.items():
+                g.attrs[f"{q}_{key}"] = v
+        elif q not in ("window", "steady", "samples"):
+            g.attrs[q] = json.dumps(value) if isinstance(value, (list, tuple)) else value
+
+
+def _read_summary(g: h5py.Group) -> RunSummary:
+    """The summary :func:`_write_summary` wrote as ``g``'s attributes."""
+    sa = {k: attr_value(v) for k, v in g.attrs.items()}
+    stored = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
+              "samples": int(sa.pop("samples"))}
+    for key in [k[:-5] for k in sa if k.endswith("_mean")]:
+        stored[key] = {stat: sa.pop(f"{key}_{stat}") for stat in SUMMARY_STATS if f"{key}_{stat}" in sa}
+    for key, value in sa.items():
+        stored[key] = json.loads(value) if key == "reasons" else value
+    return RunSummary.from_dict(stored)
+
+
 # -------------------------------------------------------------------- reading
 @dataclass
 class Result:
@@ -163,7 +188,9 @@ class Result:
     ``series``: name -> 1-D array; ``units``: name -> unit; ``summary``: the steady-state summary
     (:class:`~wheelsoil.coupling.run_summary.RunSummary`: ``summary.drawbar_pull.mean``, the window, whether it was
     steady);
-    ``attrs``: provenance and the resolved case text (``attrs['case_toml']``); ``info``: run figures.
+    ``attrs``: provenance and the resolved case text (``attrs['case_toml']``); ``info``: run figures;
+    ``stages``: every stage's summary in order (a drive of several stages, ``[[protocol.stages]]``; one stage:
+    ``(summary,)``).
     """
 
     path: Path
@@ -173,6 +200,11 @@ class Result:
     attrs: dict
     info: dict
     frame_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    stages: tuple[RunSummary, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.stages:
+            self.stages = (self.summary,)
 
     @property
     def case(self):
@@ -200,12 +232,16 @@ class Result:
         frame.index = pd.Index(self.series["t"], name="t [s]")
         return frame
 
-    def summary_row(self) -> dict:
-        """One flat row: case name and hash, the steady means and standard deviations, the window."""
-        row = {"case": self.attrs.get("case_name"), "case_hash": self.attrs.get("case_hash"),
-               "steady": self.summary.steady, "samples": self.summary.samples}
-        row["window_start"], row["window_end"] = self.summary.window
-        for q, stats in self.summary.quantities().items():
+    def summary_row(self, stage: int | None = None) -> dict:
+        """One flat row: case name and hash, the steady means and standard deviations, the window; of the run's
+        summary, or of stage ``stage`` of its drive (then with the stage's number and commanded slip)."""
+        summary = self.summary if stage is None else self.stages[stage]
+        row = {"case": self.attrs.get("case_name"), "case_hash": self.attrs.get("case_hash")}
+        if stage is not None:
+            row.update(stage=stage, commanded_slip=summary.commanded_slip)
+        row.update(steady=summary.steady, samples=summary.samples)
+        row["window_start"], row["window_end"] = summary.window
+        for q, stats in summary.quantities().items():
             row[f"{q}_mean"] = stats.mean
             row[f"{q}_std"] = stats.std
         return row
@@ -244,18 +280,13 @@ def load_result(path: str | Path) -> Result:
             raise WheelsoilInputError(f"{path} is not a complete result (the run did not finish)")
         series = {k: f["series"][k][()] for k in f["series"]}
         units = {k: attr_value(f["series"][k].attrs["units"]) for k in f["series"]}
-        sa = {k: attr_value(v) for k, v in f["summary"].attrs.items()}
-        stored = {"window": [sa.pop("window_start"), sa.pop("window_end")], "steady": bool(sa.pop("steady")),
-                  "samples": int(sa.pop("samples"))}
-        for key in [k[:-5] for k in sa if k.endswith("_mean")]:
-            stored[key] = {stat: sa.pop(f"{key}_{stat}") for stat in SUMMARY_STATS if f"{key}_{stat}" in sa}
-        for key, value in sa.items():
-            stored[key] = json.loads(value) if key == "reasons" else value
-        summary = RunSummary.from_dict(stored)
+        summary = _read_summary(f["summary"])
+        stages = tuple(_read_summary(f["stages"][k]) for k in sorted(f["stages"])) if "stages" in f else ()
         attrs = {k: attr_value(v) for k, v in f.attrs.items()}
         info = {k: attr_value(v) for k, v in f["run"].attrs.items()}
         times = np.array([f["frames"][k].attrs["t"] for k in sorted(f["frames"])])
-    return Result(path=path, series=series, units=units, summary=summary, attrs=attrs, info=info, frame_times=times)
+    return Result(path=path, series=series, units=units, summary=summary, attrs=attrs, info=info, frame_times=times,
+                  stages=stages)
 
 
 # -------------------------------------------------------------------- XDMF sidecar

@@ -155,7 +155,7 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     info = dict(result.info)
     if resumed_from is not None:
         info["resumed_from"] = resumed_from
-    writer.finish(result.series, SERIES_UNITS, result.summary, info)
+    writer.finish(result.series, SERIES_UNITS, result.summary, info, result.stages)
     ckpt_path.unlink(missing_ok=True)
     write_run_folder(out, case, result, prov)
     return RunOutcome(out=out, result_path=result_path, testbed_result=result, resumed_from=resumed_from)
@@ -174,6 +174,8 @@ def write_run_folder(out: Path, case: CaseFile, result, prov: dict) -> list[Path
     written.append(out / "series.csv")
     summary = {"case": case.name, "case_hash": case.case_hash(), "summary": result.summary.to_dict(), "run": result.info,
                "testbed": result.spec.to_dict(), "bed": result.bed_summary, "provenance": prov}
+    if len(result.stages) > 1:  # a drive of several stages: each stage's summary, in order (the last is "summary")
+        summary["stages"] = [st.to_dict() for st in result.stages]
     with atomic_output(out / "summary.json") as tmp:
         tmp.write_text(json.dumps(summary, indent=2, default=str))
     written.append(out / "summary.json")

@@ -1,7 +1,7 @@
 """The case file: a TOML description of one testbed run, read, validated by a pydantic schema (the section models
 in :mod:`.case_model`), checked against the solver's cross-checks, and written back.
 
-A case has six sections; every key has a default (the smoke steering run, :mod:`wheelsoil.parameters.smoke`), so
+A case has seven sections; every key has a default (the smoke steering run, :mod:`wheelsoil.parameters.smoke`), so
 a case file holds only what differs from it. Each key's allowed range is the solver spec's own (``RANGES`` of
 ``TestbedSpec``, ``BedSpec``, ``WheelGeometry``, ``Material``, ``PairProperties``); :mod:`.build` turns a case into
 those specs. ``wheelsoil case show`` prints every key with its unit, range and default.
@@ -12,6 +12,7 @@ those specs. ``wheelsoil case show`` prints every key with its unit, range and d
     [contact]   soil--wheel restitution and friction
     [test]      what the rig does: slip, steering angle, load, wheel speed, timing
     [output]    sampling, steady-state detection, frames kept in the result, checkpoints, the render
+    [protocol]  further stages of the drive after the first (a slip ramp: stages = [{slip = 0.3}, {slip = 0.5}])
 
 Values are SI numbers in the key's unit (angles in degrees), or strings with a unit of the same
 dimension ("600 ms", "3 kN", "30 %"; :mod:`wheelsoil.cases.units`). Errors name the file, the key,
@@ -36,7 +37,7 @@ from pydantic import ValidationError
 from wheelsoil.errors import WheelsoilInputError
 
 from . import build
-from .case_model import SECTIONS, CaseError, CaseFile
+from .case_model import SECTIONS, CaseError, CaseFile, Stage
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -93,8 +94,8 @@ def _lookup(data: dict, loc: tuple):
     return data
 
 
-def _limits(section: str, key: str, *, with_unit: bool = True) -> str:
-    model = SECTIONS.get(section)
+def _limits(section: str, key: str, *, with_unit: bool = True, model=None) -> str:
+    model = model or SECTIONS.get(section)
     field = model.model_fields.get(key) if model else None
     if field is None:
         return ""
@@ -122,12 +123,17 @@ def _messages(exc: ValidationError, data: dict) -> list[str]:
             if len(path) == 1:
                 out.append(f"unknown section [{path[0]}]{_suggest(str(path[0]), SECTIONS)}")
             else:
-                model = SECTIONS.get(str(path[0]))
+                stage = len(path) == 4 and path[0] == "protocol"
+                model = Stage if stage else SECTIONS.get(str(path[0]))
                 options = list(model.model_fields) if model else []
-                out.append(f"unknown key {key}{_suggest(str(path[-1]), options, f'{path[0]}.')}")
+                prefix = ".".join(map(str, path[:3])) + "." if stage else f"{path[0]}."
+                out.append(f"unknown key {key}{_suggest(str(path[-1]), options, prefix)}")
             continue
         value = _lookup(data, tuple(path))
-        limits = _limits(str(path[0]), str(path[1])) if len(path) >= 2 else ""
+        if len(path) == 4 and tuple(path[:2]) == ("protocol", "stages"):  # a key of one stage, protocol.stages.<k>.key
+            limits = _limits("protocol", str(path[3]), model=Stage)
+        else:
+            limits = _limits(str(path[0]), str(path[1])) if len(path) >= 2 else ""
         msg = err["msg"].removeprefix("Value error, ")
         out.append(f"{key} = {value!r}: {msg}{limits}")
     # a union reports every alternative; one line per key is enough
@@ -233,6 +239,8 @@ def _toml_value(value) -> str:
         return json.dumps(value)  # JSON string escapes are valid TOML basic strings
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):  # an inline table, its unset keys left out
+        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items() if v is not None) + "}"
     raise TypeError(f"no TOML form for {value!r}")
 
 
@@ -246,6 +254,9 @@ def case_to_toml(case: CaseFile, *, comments: bool = True, template: bool = Fals
     lines = [f"# wheelsoil case (schema of wheelsoil {_version()}); every key shown, defaults filled in"]
     for section, model in SECTIONS.items():
         values = getattr(case, section)
+        if section == "protocol":
+            lines += _protocol_lines(values, comments=comments, template=template)
+            continue
         lines += ["", f"[{section}]"]
         for key, field in model.model_fields.items():
             value = getattr(values, key)
@@ -260,6 +271,19 @@ def case_to_toml(case: CaseFile, *, comments: bool = True, template: bool = Fals
             else:
                 lines.append(f"{key} = {_toml_value(value)}{note}")
     return "\n".join(lines) + "\n"
+
+
+def _protocol_lines(protocol, *, comments: bool, template: bool) -> list[str]:
+    """The ``[protocol]`` section: its stages as inline tables; nothing for a one-stage drive (so the text of a case
+    written before the section existed is unchanged), except a commented example in a ``template``."""
+    if protocol.stages:
+        note = f"  # {type(protocol).model_fields['stages'].description}" if comments else ""
+        return ["", "[protocol]", f"stages = {_toml_value([st.model_dump() for st in protocol.stages])}{note}"]
+    if template:
+        return ["", "# [protocol]", "# stages = [{slip = 0.3}, {slip = 0.5, drive_time = 6.0}]  # further stages of "
+                "the drive after the first at test.slip, each until steady (a slip ramp); keys: slip, drive_time [s], "
+                "ramp_time [s]"]
+    return []
 
 
 def _version() -> str:

@@ -101,10 +101,14 @@ def _flatten(table: dict, prefix: str = "") -> dict:
 
 
 def _label(value) -> str:
+    """A swept value as part of a case name: numbers short, lists joined by "x" (none: "none"), tables (a drive
+    stage) as key and value joined by "+"."""
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, (list, tuple)):
-        return "x".join(_label(v) for v in value)
+        return "x".join(_label(v) for v in value) if value else "none"
+    if isinstance(value, dict):
+        return "+".join(f"{k}{_label(v)}" for k, v in value.items())
     return str(value).replace(" ", "")
 
 
@@ -295,27 +299,37 @@ def _write_status(sweep: Sweep, status: dict) -> None:
 # -------------------------------------------------------------------- summary
 def summary_table(sweep: Sweep):
     """A pandas DataFrame: one row per finished case with its swept values, rig settings and wheel, and the
-    steady means and standard deviations (SI: N, m, N m; angles in degrees; gravity in m/s^2)."""
+    steady means and standard deviations (SI: N, m, N m; angles in degrees; gravity in m/s^2). A case whose drive
+    has several stages (``[[protocol.stages]]``, a slip ramp) gives one row per stage, its ``slip_set`` the stage's
+    commanded slip, with a ``stage`` column (0: the first) in every row of the table."""
     import pandas as pd
 
     from .results import load_result
 
-    rows = []
+    rows, staged = [], False
     for c in sweep.cases:
         if not c.finished:
             continue
         r = load_result(c.folder / RESULT_NAME)
         t = c.case.test
-        row = {"case": c.name, "case_hash": c.folder.name}
-        row.update({k: (_label(v) if isinstance(v, (list, tuple)) else v) for k, v in c.values.items()})
+        head = {"case": c.name, "case_hash": c.folder.name}
+        head.update({k: (_label(v) if isinstance(v, (list, tuple)) else v) for k, v in c.values.items()})
         wheel = build.wheel_geometry(c.case)
-        row.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "slip_speed": t.slip_speed,
-                    "load_set": t.load, "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
-                    "wheel_radius": wheel.radius, "wheel_width": wheel.width, "grouser_count": wheel.grouser_count,
-                    "grouser_height": wheel.grouser_height if wheel.grouser_count else 0.0})
-        row.update({k: v for k, v in r.summary_row().items() if k not in ("case", "case_hash")})
-        rows.append(row)
-    return pd.DataFrame(rows)
+        head.update({"slip_set": t.slip, "slip_angle_set": t.slip_angle, "slip_speed": t.slip_speed,
+                     "load_set": t.load, "gravity": -c.case.soil.gravity_vector[2], "rigid": c.case.wheel.rigid,
+                     "wheel_radius": wheel.radius, "wheel_width": wheel.width, "grouser_count": wheel.grouser_count,
+                     "grouser_height": wheel.grouser_height if wheel.grouser_count else 0.0})
+        if len(r.stages) == 1:
+            rows.append({**head, **{k: v for k, v in r.summary_row().items() if k not in ("case", "case_hash")}})
+            continue
+        staged = True
+        for k in range(len(r.stages)):
+            stage = {key: v for key, v in r.summary_row(k).items() if key not in ("case", "case_hash")}
+            rows.append({**head, "slip_set": stage.pop("commanded_slip"), **stage})
+    table = pd.DataFrame(rows)
+    if staged:
+        table["stage"] = table["stage"].fillna(0).astype(int)
+    return table
 
 
 def write_summary(sweep: Sweep) -> list[Path]:

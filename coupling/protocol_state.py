@@ -5,11 +5,15 @@ and a resumed run reads it back (:meth:`ProtocolState.from_dict`). No Taichi."""
 
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 
-#: The protocol's phases, in order ("new" before a run starts, "done" after it ends).
-PHASES = ("new", "lower", "settle", "spin-up", "wind-up", "drive", "done")
+from .run_summary import RunSummary
+
+#: The protocol's phases, in order ("new" before a run starts, "done" after it ends); a drive of several stages
+#: (``TestbedSpec.stages``) repeats "ramp", "wind-up" and "drive" for each further stage.
+PHASES = ("new", "lower", "settle", "spin-up", "wind-up", "drive", "ramp", "done")
 
 
 @dataclass
@@ -28,6 +32,11 @@ class ProtocolState:
     shift: how far the moving soil patch has re-centred the wheel [m].
     windup_converged: the wind-up ended because the tread reached the commanded slip (not at its time limit).
     steady_in_a_row: consecutive checks that found the run steady.
+    step: the running step's place in the protocol's list (None: the first step named ``phase``, as in a checkpoint
+        written before protocols could repeat a step).
+    stage: the drive's stage now (0: the first, at the spec's slip); ramp_spin, ramp_speed: the hub's spin [rad/s]
+        and the carriage's speed [m/s] when the running stage's ramp began.
+    finished_stages: the summaries of the stages that have ended, in order (the last stage's is the run's summary).
     """
 
     phase: str = "lower"
@@ -45,16 +54,24 @@ class ProtocolState:
     shift: float = 0.0
     windup_converged: bool = False
     steady_in_a_row: int = 0
+    step: int | None = None
+    stage: int = 0
+    ramp_spin: float = 0.0
+    ramp_speed: float = 0.0
+    finished_stages: tuple[RunSummary, ...] = ()
 
     def __post_init__(self) -> None:
         if self.phase not in PHASES:
             raise ValueError(f"protocol phase {self.phase!r} is not one of {', '.join(PHASES)}")
 
     def to_dict(self) -> dict:
-        """Plain scalars for a checkpoint (an unset ``tread_angle`` is left out)."""
-        d = asdict(self)
-        if self.tread_angle is None:
-            del d["tread_angle"]
+        """Plain scalars for a checkpoint (an unset ``tread_angle`` or ``step`` is left out; the finished stages'
+        summaries as one JSON text)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        for key in ("tread_angle", "step"):
+            if d[key] is None:
+                del d[key]
+        d["finished_stages"] = json.dumps([st.to_dict() for st in self.finished_stages])
         return d
 
     @classmethod
@@ -73,8 +90,10 @@ class ProtocolState:
                 values[key] = str(value)
             elif key == "windup_converged":
                 values[key] = bool(value)
-            elif key == "steady_in_a_row":
+            elif key in ("steady_in_a_row", "step", "stage"):
                 values[key] = int(value)
+            elif key == "finished_stages":
+                values[key] = tuple(RunSummary.from_dict(st) for st in json.loads(value))
             else:
                 values[key] = float(value)
         return cls(**values)

@@ -9,7 +9,7 @@ Conventions (architecture; seed 004 eqs. 14--16; the measured rigs' slip): see :
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import ClassVar
 
 from wheelsoil.errors import WheelsoilInputError
@@ -30,6 +30,34 @@ SLIP_SPEEDS = ("heading", "travel")
 def _check(key: str, value, ok: bool, allowed: str) -> None:
     if not ok:
         raise WheelsoilInputError(f"testbed {key} = {value!r} is out of range: allowed {allowed}")
+
+
+@dataclass(frozen=True)
+class DriveStage:
+    """A further stage of the drive, after the first (which runs at the spec's own ``slip``): the carriage and the
+    hub ramp from the previous stage's command to this stage's over ``ramp_time``, a flexible wheel winds up again,
+    and the wheel drives until steady (or for ``drive_time``), each stage with its own steady window and summary. A
+    list of stages is a slip ramp on one bed and one lowering (:func:`stage_spec`).
+
+    slip: the stage's commanded slip, in [-1, 1) as :attr:`TestbedSpec.slip`.
+    drive_time: the stage's longest drive after its ramp [s] (None: the spec's ``drive_time``).
+    ramp_time: the time over which the command moves to the stage's [s] (None: the spec's ``spin_up_time``).
+    """
+
+    __test__ = False
+
+    slip: float
+    drive_time: float | None = None
+    ramp_time: float | None = None
+
+    RANGES: ClassVar[dict[str, Range]] = {"slip": Range(-1.0, 1.0, hi_open=True), "drive_time": positive(),
+                                          "ramp_time": non_negative()}
+
+    def __post_init__(self) -> None:
+        check_ranges(self, self.RANGES, "protocol stage", {"drive_time": "s", "ramp_time": "s"})
+
+    def to_dict(self) -> dict:
+        return asdict(self)
 
 
 @dataclass(frozen=True)
@@ -82,6 +110,8 @@ class TestbedSpec:
         stiffness from ringing through the run; its force is updated every sample interval. None: wheel
         mass / 0.1 s (a free heave decays in 0.1 s; roughly 0.4 of critical damping for the smoke case's
         heave on the soil); 0: no damper.
+    stages: further stages of the drive (:class:`DriveStage`), each after the one before has ended (steady, or at
+        its ``drive_time``): a slip ramp on one bed and one lowering. Empty (the default): one drive at ``slip``.
     patch_shift: on a periodic bed, the moving soil patch re-centres the wheel whenever it has travelled
         this far [m] (:mod:`.patch`); None: a fifth of the wheel radius.
     time_step: DEM time step of the run [s] (None: the bed's stable estimate); the bed is prepared with its own,
@@ -118,6 +148,7 @@ class TestbedSpec:
     patch_shift: float | None = None
     time_step: float | None = None
     pair: PairProperties = smoke.CONTACT
+    stages: tuple[DriveStage, ...] = ()
 
     #: Allowed range of every scalar input (None: "use the default" where a default is computed). The case
     #: schema's [test], [output] and wheel.damping fields take their bounds from here.
@@ -165,11 +196,39 @@ class TestbedSpec:
                f"sample_interval <= average_time / 4 = {0.25 * self.average_time:g} s")
         if not isinstance(self.pair, PairProperties):
             raise WheelsoilInputError(f"testbed pair must be a PairProperties, got {type(self.pair).__name__}")
+        if not isinstance(self.stages, tuple) or not all(isinstance(st, DriveStage) for st in self.stages):
+            raise WheelsoilInputError("testbed stages must be a tuple of DriveStage")
+        for k, st in enumerate(self.stages):
+            if st.drive_time is not None:
+                _check(f"stages[{k}].drive_time", st.drive_time, self.average_time < st.drive_time,
+                       f"more than average_time = {self.average_time} s")
+
+    @property
+    def n_stages(self) -> int:
+        """The drive's stages: the first, at ``slip``, and the further :attr:`stages`."""
+        return 1 + len(self.stages)
 
     def to_dict(self) -> dict:
+        """Plain values (``stages`` only where there are further stages, so a one-stage spec reads as before)."""
         d = asdict(self)
         d["pair"] = self.pair.to_dict()
+        d.pop("stages")
+        if self.stages:
+            d["stages"] = [st.to_dict() for st in self.stages]
         return d
+
+
+def stage_spec(spec: TestbedSpec, k: int) -> TestbedSpec:
+    """The rig's settings during stage ``k`` of the drive (0: ``spec`` itself; k >= 1: its ``stages[k - 1]``'s slip,
+    drive time and ramp time in place of ``slip``, ``drive_time`` and ``spin_up_time``, without further stages)."""
+    if k == 0:
+        return spec
+    if not 1 <= k <= len(spec.stages):
+        raise ValueError(f"the drive has stages 0 to {len(spec.stages)}, not {k}")
+    st = spec.stages[k - 1]
+    return replace(spec, slip=st.slip, stages=(),
+                   drive_time=st.drive_time if st.drive_time is not None else spec.drive_time,
+                   spin_up_time=st.ramp_time if st.ramp_time is not None else spec.spin_up_time)
 
 
 def carriage_speed(spec: TestbedSpec, radius: float) -> tuple[float, float]:
@@ -284,14 +343,19 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     if bed.periodic:
         shift = spec.patch_shift or 0.2 * wheel.radius
         return PatchGeometry.for_wheel(bed.length, outer, shift, bed.diameter_max).check(spec.start_x)
-    speed = carriage_speed(spec, wheel.radius)[1]
-    travel = abs(speed) * (spec.drive_time + spec.spin_up_time)
+    # every stage's longest drive and ramp at that stage's carriage speed (the ramp's at the faster of its ends)
+    stages = [stage_spec(spec, k) for k in range(spec.n_stages)]
+    speed = max(abs(carriage_speed(st, wheel.radius)[1]) for st in stages)
+    travel = sum(abs(carriage_speed(st, wheel.radius)[1]) * st.drive_time
+                 + max(abs(carriage_speed(st, wheel.radius)[1]), abs(carriage_speed(prev, wheel.radius)[1]))
+                 * st.spin_up_time for prev, st in zip([stages[0]] + stages[:-1], stages))
     start_x = spec.start_x if spec.start_x is not None else outer + 0.1
     if start_x - outer < 0 or start_x + travel + outer > bed.length:
         raise WheelsoilInputError(
-            f"the bin (soil.length = {bed.length} m) is too short for test.drive_time = {spec.drive_time} s: "
+            f"the bin (soil.length = {bed.length} m) is too short for test.drive_time = {spec.drive_time} s"
+            f"{f' and its further stages (protocol.stages)' if spec.stages else ''}: "
             f"the wheel (outer radius {outer:.3f} m) starts at x = {start_x:.3f} m and may travel "
-            f"{travel:.3f} m at {speed:.3f} m/s; shorten drive_time, use a longer bin, or a "
+            f"{travel:.3f} m at up to {speed:.3f} m/s; shorten drive_time, use a longer bin, or a "
             "periodic bed (soil.periodic = true: a moving soil patch holds any drive)"
         )
     return start_x

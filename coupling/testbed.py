@@ -68,10 +68,10 @@ from .coupled_state import restore_coupled_state, take_coupled_state
 from .kinematics import TreadTracker, deformation, rig_command, yaw_matrix
 from .patch import MovingPatch
 from .placement import wheel_start_centre
-from .protocol import DEFAULT_PROTOCOL, advance, step_named
+from .protocol import advance, protocol_for, running_step
 from .protocol_state import ProtocolState
 from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig, soil_headroom,
-                  statistics_pitch)
+                  stage_spec, statistics_pitch)
 from .run_progress import RunProgress
 from .run_statistics import detect_from_rows
 from .run_summary import SERIES_UNITS
@@ -106,13 +106,7 @@ class Testbed:
         outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
         self.outer_radius = outer
         self.gravity = -float(bs.gravity[2])
-        # the hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] (kinematics.rig_command)
-        self.spin_command, self.travel_speed = carriage_speed(spec, wheel.radius)
-        #: the commanded speed [m/s] the slip is taken against (spec.slip_speed: along the heading, or the travel)
-        self.slip_reference_speed = rig_command(spec.slip, spec.angular_velocity, wheel.radius)[1]
-        #: the rate [rad/s] at which the statistics' batches pass: the hub's spin, or for a dragged wheel (no
-        #: spin) the angle it would roll through at its travel speed
-        self.batch_rate = batch_rate(spec.slip, spec.angular_velocity, wheel.radius)
+        self.enter_stage(0)
         self.periodic = bool(bs.periodic)
         start_x = plan.start_x
         if self.periodic:
@@ -166,7 +160,21 @@ class Testbed:
         self.rows: dict | None = None
         self.steady_state: SteadyState | None = None
         #: the rig's protocol, a list of steps (:mod:`.protocol`); the run's state is :attr:`protocol_state`
-        self.protocol = DEFAULT_PROTOCOL
+        self.protocol = protocol_for(spec.n_stages)
+
+    def enter_stage(self, k: int) -> None:
+        """Take stage ``k`` of the drive's settings (:func:`~.rig.stage_spec`) as the rig's command: what the
+        protocol's steps, the steady-state detector and the summary read (:attr:`stage_spec`)."""
+        s, radius = stage_spec(self.spec, k), self.wheel.radius
+        #: the running stage's rig settings (the spec itself for the first stage)
+        self.stage_spec = s
+        # the hub's commanded spin [rad/s] and the carriage's speed along the bin [m/s] (kinematics.rig_command)
+        self.spin_command, self.travel_speed = carriage_speed(s, radius)
+        #: the commanded speed [m/s] the slip is taken against (spec.slip_speed: along the heading, or the travel)
+        self.slip_reference_speed = rig_command(s.slip, s.angular_velocity, radius)[1]
+        #: the rate [rad/s] at which the statistics' batches pass: the hub's spin, or for a dragged wheel (no
+        #: spin) the angle it would roll through at its travel speed
+        self.batch_rate = batch_rate(s.slip, s.angular_velocity, radius)
 
     # ------------------------------------------------------------------ the rig's commands
     @property
@@ -238,7 +246,7 @@ class Testbed:
     def _set_drive(self) -> None:
         """The hub's spin and the carriage's speed for the sample about to be taken, from the running step."""
         loop = self._loop
-        command = step_named(self.protocol, loop.phase).command(self, loop, self.scene.time)
+        command = self.protocol[running_step(self.protocol, loop)].command(self, loop, self.scene.time)
         if command is not None:
             loop.hub_spin = command[0]
             self._command(*command)
@@ -269,8 +277,9 @@ class Testbed:
         return advance(self.protocol, self, loop, row, self.scene.time)
 
     def detect(self) -> SteadyState:
-        """The steady-state detector's verdict on the rows so far (:func:`~.run_statistics.detect_from_rows`)."""
-        s = self.spec
+        """The steady-state detector's verdict on the running stage's rows so far
+        (:func:`~.run_statistics.detect_from_rows`)."""
+        s = self.stage_spec
         return detect_from_rows(
             self.rows, slip=s.slip, load=s.load, angular_velocity=s.angular_velocity, average_time=s.average_time,
             steady_tolerance=s.steady_tolerance, slip_tolerance=s.slip_tolerance, radius=self.wheel.radius,
@@ -303,6 +312,7 @@ class Testbed:
         if self.patch is not None:
             self.patch.restore_state(state["patch"])
         self._loop = ProtocolState.from_dict(state["testbed"]["loop"])
+        self.enter_stage(self._loop.stage)
         self.rows = {k: [float(v) for v in np.asarray(rows[k])] for k in SERIES_UNITS}
 
     def deformation(self, nodes: np.ndarray | None = None) -> np.ndarray:

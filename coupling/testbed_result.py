@@ -31,26 +31,38 @@ class TestbedResult:
     final_wheel_nodes: np.ndarray | None = None
     final_deformation: np.ndarray | None = None
     mesh: StructureMesh | None = None
+    #: every stage's summary, in order (``TestbedSpec.stages``; one stage: ``(summary,)``)
+    stages: tuple[RunSummary, ...] = ()
 
     def steady(self, name: str) -> float:
         """Steady-state mean of a quantity (see :data:`~.run_summary.SUMMARY_QUANTITIES`)."""
         return self.summary.mean(name)
 
 
-def testbed_result(bench, rows: dict, wall: float) -> TestbedResult:
-    """What a finished :class:`~.testbed.Testbed` run returns: its series ``rows`` (NumPy arrays), the summary over the
-    steady window it found (or, where none, over the drive's last ``average_time``, said to be unsteady), the run's
-    figures (``wall`` [s] of wall time) and its last state."""
-    s, loop = bench.spec, bench.protocol_state
+def stage_summary(bench, rows: dict | None = None) -> RunSummary:
+    """The summary of the drive's running stage, now: over the steady window :attr:`~.testbed.Testbed.steady_state`
+    holds (or the detector finds), or, where none, over the drive's last ``average_time``, said to be unsteady.
+    ``rows``: the series as NumPy arrays (default: the testbed's rows so far)."""
+    s = bench.stage_spec
+    rows = rows if rows is not None else {k: np.asarray(v) for k, v in bench.rows.items()}
     state = bench.steady_state if bench.steady_state is not None else bench.detect()
     t = rows["t"]
     k0, k1 = state.k0, state.k1
     if k1 - k0 < 2:  # nothing to average over: the last average_time of the drive, said to be unsteady
         k1 = len(t)
         k0 = max(0, int(np.searchsorted(t, t[-1] - s.average_time)))
-    summary = summarise_window(rows, state, k0, k1, period_pitches=bench.period_pitches,
-                               sample_interval=bench.steps_per_sample * bench.dt, pitch=bench.pitch,
-                               commanded_slip=s.slip, commanded_slip_angle=s.slip_angle)
+    return summarise_window(rows, state, k0, k1, period_pitches=bench.period_pitches,
+                            sample_interval=bench.steps_per_sample * bench.dt, pitch=bench.pitch,
+                            commanded_slip=s.slip, commanded_slip_angle=s.slip_angle)
+
+
+def testbed_result(bench, rows: dict, wall: float) -> TestbedResult:
+    """What a finished :class:`~.testbed.Testbed` run returns: its series ``rows`` (NumPy arrays), the summary of its
+    last stage (:func:`stage_summary`) and every stage's, the run's figures (``wall`` [s] of wall time) and its last
+    state."""
+    s, loop = bench.spec, bench.protocol_state
+    t = rows["t"]
+    summary = stage_summary(bench, rows)
     particles = {"position": bench.scene.positions, "velocity": bench.scene.velocities, "radius": bench.scene.radii}
     nodes = bench.structure.positions()
     info = {
@@ -75,4 +87,5 @@ def testbed_result(bench, rows: dict, wall: float) -> TestbedResult:
     }
     return TestbedResult(series=rows, summary=summary, spec=s, wheel=bench.wheel, bed_summary=bench.bed.summary(),
                          info=info, final_particles=particles, final_wheel_nodes=nodes,
-                         final_deformation=bench.deformation(nodes), mesh=bench.mesh)
+                         final_deformation=bench.deformation(nodes), mesh=bench.mesh,
+                         stages=loop.finished_stages + (summary,))

@@ -2,8 +2,8 @@
 number in docs/cmu-twin/README.md is copied by hand.
 
 For each sweep folder ``RUNS/cmu-*`` (the subset, the candidates, the replicas, the speed check) and each case in it
-that has finished (``summary.json``): the wheel, steering angle, commanded slip, load and seed from its
-``case.toml``; whether the steady-state detector found it steady and over which window; the steady (or, where not
+that has finished (its ``result.h5``, read as a typed result): the wheel, steering angle, commanded slip, load and
+seed of the case it ran; whether the steady-state detector found it steady and over which window; the steady (or, where not
 steady, the window's) means of the drawbar pull, the lateral force and the tread sinkage with their 95 % intervals
 (the detector's own: one run's, without the run-to-run spread the replicas measure); and the measured trial of the
 same wheel, steering angle and load (each trial's load is its own) with its mean and standard deviation, in wheelsoil's
@@ -20,11 +20,9 @@ Usage (from the repository root; seconds)::
 """
 
 import argparse
-import json
 import math
 import shutil
 import sys
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -37,30 +35,36 @@ QUANTITIES = {"drawbar_pull": ("drawbar_pull", "drawbar pull", 1.0, "N"),
 
 
 def finished_runs(runs: Path) -> list[dict]:
-    """One record per finished case of every ``runs/cmu-*`` sweep folder (sorted by sweep and case hash); a case
-    folder linked from another sweep (a convergence study's reference) is listed under its own sweep only."""
+    """One record per finished case of every ``runs/cmu-*`` sweep folder (sorted by sweep and case hash), read as
+    typed results (``wheelsoil.cases.load_result``: the case it ran and its summary); a case whose drive has several
+    stages (a slip ramp) gives one record per stage, at the stage's slip. A case folder linked from another sweep (a
+    convergence study's reference) is listed under its own sweep only."""
+    from wheelsoil.cases.results import load_result
+    from wheelsoil.cases.run import RESULT_NAME
+
     out, seen = [], set()
     for sweep in sorted(p for p in runs.glob("cmu-*") if p.is_dir()):
         for folder in sorted((sweep / "cases").glob("*")):
-            if folder.is_symlink() or not (folder / "summary.json").is_file() or folder.resolve() in seen:
+            if folder.is_symlink() or not (folder / RESULT_NAME).is_file() or folder.resolve() in seen:
                 continue  # a link (a convergence study's reference) is listed under the sweep it belongs to
             seen.add(folder.resolve())
-            case = tomllib.loads((folder / "case.toml").read_text())
-            summary = json.loads((folder / "summary.json").read_text())
-            s = summary["summary"]
-            record = {"sweep": sweep.name, "case_hash": folder.name, "wheel": case["wheel"]["preset"],
-                      "seed": case["case"]["seed"], "slip": case["test"]["slip"],
-                      "slip_angle": case["test"]["slip_angle"], "load": case["test"]["load"],
-                      "drive_time": case["test"]["drive_time"],
-                      "bin": [case["soil"]["length"], case["soil"]["width"], case["soil"]["depth"]],
-                      "steady": bool(s["steady"]), "window": s["window"], "reasons": s.get("reasons", []),
-                      "wall_seconds": summary["run"].get("wall_seconds"),
-                      "simulated_seconds": summary["run"].get("simulated_seconds")}
-            for q in QUANTITIES:
-                record[q] = {"mean": s[q]["mean"], "ci95": s[q]["ci95"]}
-            record["tread_slip"] = s["tread_slip"]["mean"]
-            record["vertical_force"] = s["vertical_force"]["mean"]
-            out.append(record)
+            result = load_result(folder)
+            case = result.case
+            for k, s in enumerate(result.stages):
+                record = {"sweep": sweep.name, "case_hash": folder.name, "wheel": case.wheel.preset,
+                          "seed": case.case.seed, "slip": s.commanded_slip, "slip_angle": case.test.slip_angle,
+                          "load": case.test.load, "drive_time": case.test.drive_time,
+                          "bin": [case.soil.length, case.soil.width, case.soil.depth],
+                          "steady": bool(s.steady), "window": list(s.window), "reasons": list(s.reasons),
+                          "wall_seconds": result.info.get("wall_seconds"),
+                          "simulated_seconds": result.info.get("simulated_seconds")}
+                if len(result.stages) > 1:
+                    record["stage"] = k
+                for q in QUANTITIES:
+                    record[q] = {"mean": s.quantity(q).mean, "ci95": s.quantity(q).ci95}
+                record["tread_slip"] = s.tread_slip.mean
+                record["vertical_force"] = s.vertical_force.mean
+                out.append(record)
     return out
 
 
@@ -131,7 +135,7 @@ def main(argv=None) -> int:
     steady = sum(r["steady"] for r in records)
     lines = ["# The CMU twin's finished runs beside their trials (issue 34)", "",
              f"Generated by `python docs/cmu_twin_runs.py --runs RUNS --out {args.out}` from the runs' own "
-             "`case.toml` and `summary.json`; the rules that judge them are in [the twin's README](../README.md). "
+             "`result.h5` (read as typed results); the rules that judge them are in [the twin's README](../README.md). "
              f"{len(records)} finished runs, {steady} of them steady. The intervals are each run's own (the steady-"
              "state detector's 95 %), without the run-to-run spread; a run not steady gives no number and is listed "
              "for information. Signs are wheelsoil's (the lateral force opposes the lateral slip); the residual is "

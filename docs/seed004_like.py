@@ -28,10 +28,8 @@ Usage (from the repository root; seconds)::
 """
 
 import argparse
-import json
 import math
 import sys
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -57,14 +55,17 @@ REPLICAS = {"earth": Path("docs/replicas/smoke-1g-steer/replicas.json"),
 
 
 def read_runs(folder: Path) -> dict:
-    """(gravity, load, steering angle, slip) -> {"steady": bool, q: (mean, sem)} of every finished case."""
+    """(gravity, load, steering angle, slip) -> {"steady": bool, q: (mean, sem)} of every finished case, read as typed
+    results (``wheelsoil.cases.load_result``: the case it ran and its summary)."""
+    from wheelsoil.cases.results import load_result
+    from wheelsoil.cases.run import RESULT_NAME
+
     runs = {}
-    for case in sorted((folder / "cases").glob("*/summary.json")):
-        toml = tomllib.loads((case.parent / "case.toml").read_text())
-        s = json.loads(case.read_text())["summary"]
-        key = (toml["soil"]["gravity"], float(toml["test"]["load"]), float(toml["test"]["slip_angle"]),
-               round(float(toml["test"]["slip"]), 6))
-        runs[key] = {"steady": bool(s["steady"]), **{q: (s[q]["mean"], s[q]["sem"]) for q in QUANTITIES}}
+    for path in sorted((folder / "cases").glob(f"*/{RESULT_NAME}")):
+        result = load_result(path)
+        test, s = result.case.test, result.summary
+        key = (result.case.soil.gravity, float(test.load), float(test.slip_angle), round(float(test.slip), 6))
+        runs[key] = {"steady": bool(s.steady), **{q: (s.quantity(q).mean, s.quantity(q).sem) for q in QUANTITIES}}
     return runs
 
 

@@ -1,5 +1,6 @@
 """The single-wheel testbed at a tiny scale: force balance, signs, no particle inside the wheel, bad input."""
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -7,7 +8,7 @@ import pytest
 
 from wheelsoil.coupling.surface import ContactSurface
 from wheelsoil.coupling.testbed import Testbed
-from wheelsoil.coupling.rig import TestbedSpec, check_fits, plan_rig
+from wheelsoil.coupling.rig import DriveStage, TestbedSpec, check_fits, plan_rig
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry
 from wheelsoil.flexwheel.material import SEED004_WHEEL
@@ -202,10 +203,11 @@ def test_a_testbed_from_a_checked_plan_is_the_one_from_wheel_and_spec(mini_bed):
         Testbed(mini_bed, MINI_WHEEL, plan=plan)
 
 
-def _mean_and_error(result, name, blocks=4):
-    """Steady mean and its standard error from block means (the series is correlated in time)."""
-    t0 = result.summary.window[0]
-    y = result.series[name][result.series["t"] >= t0]
+def _mean_and_error(result, name, blocks=4, window=None):
+    """Steady mean and its standard error from block means (the series is correlated in time), over the summary's
+    window from its start on, or over ``window`` (t0, t1] [s]."""
+    t, (t0, t1) = result.series["t"], window or (result.summary.window[0], np.inf)
+    y = result.series[name][(t >= t0) & (t <= t1)]
     means = np.array([b.mean() for b in np.array_split(y, blocks)])
     return means.mean(), means.std(ddof=1) / np.sqrt(blocks)
 
@@ -226,6 +228,44 @@ def test_drawbar_pull_and_torque_rise_with_slip(mini_bed):
     for q in ("drawbar_pull", "torque"):
         (lo, e_lo), (hi, e_hi) = (_mean_and_error(runs[i], q) for i in (0.1, 0.6))
         assert hi - lo > 3.0 * np.hypot(e_lo, e_hi), (q, lo, e_lo, hi, e_hi)
+
+
+@pytest.mark.slow  # about 1.6 s simulated, and its last 0.5 s again: about 4 minutes on 2 cores
+def test_a_slip_ramp_drives_each_stage_at_its_slip_and_resumes_inside_a_later_stage(mini_bed, bed_cache):
+    """One run of two stages, slip 0.1 then 0.6 (``TestbedSpec.stages``; on the periodic bin, whose moving patch
+    holds both drives): each stage's summary is at its own commanded slip, the hub's slip over its window is that
+    slip, DP and torque rise from the first stage to the second by more than three combined standard errors (the
+    two-run check above, in one run), and a run restored from a state taken in the second stage continues bit for
+    bit (the protocol's step and stage come back with it)."""
+    bed = prepare_bed(replace(MINI_BED, periodic=True), cache_dir=bed_cache)
+    spec = replace(MINI_RUN, slip=0.1, slip_angle=0.0, windup="none", drive_time=0.5, average_time=_PITCH_TIME,
+                   stages=(DriveStage(0.6),))
+    taken = {}
+
+    def keep(bench):  # the state one pitch into the second stage's drive
+        loop = bench.protocol_state
+        if loop.stage == 1 and bench.phase == "drive" and bench.scene.time > loop.t_hold + _PITCH_TIME and not taken:
+            taken["state"], taken["t"] = bench.state(), bench.scene.time
+
+    result = Testbed(bed, MINI_WHEEL, spec).run(progress=True, on_sample=keep)
+    assert [s.commanded_slip for s in result.stages] == [0.1, 0.6] and result.stages[-1] is result.summary
+    first, second = result.stages
+    assert first.window[1] < second.window[0]
+    t = result.series["t"]
+    for stage in result.stages:
+        inside = (t > stage.window[0]) & (t <= stage.window[1])
+        assert result.series["slip"][inside] == pytest.approx(stage.commanded_slip, abs=1e-9)
+    assert first.tread_slip.mean < second.tread_slip.mean  # the tread follows the hub (within its wind-up)
+    for q in ("drawbar_pull", "torque"):
+        (lo, e_lo), (hi, e_hi) = (_mean_and_error(result, q, window=st.window) for st in (first, second))
+        assert hi - lo > 3.0 * np.hypot(e_lo, e_hi), (q, lo, e_lo, hi, e_hi)
+    resumed = Testbed(bed, MINI_WHEEL, spec)
+    resumed.restore_state(taken["state"])
+    assert resumed.stage_spec.slip == 0.6 and resumed.phase == "drive"
+    again = resumed.run()
+    for name in result.series:
+        np.testing.assert_array_equal(again.series[name], result.series[name], err_msg=name)
+    assert json.dumps([s.to_dict() for s in again.stages]) == json.dumps([s.to_dict() for s in result.stages])
 
 
 #: One grouser pitch of the mini wheel at its test spin [s] (and a little more, so the window holds it whole).

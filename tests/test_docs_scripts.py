@@ -64,35 +64,37 @@ def test_the_twin_queue_links_a_finished_run_as_a_bin_checks_reference(tmp_path)
 
 
 def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_dir):
-    """docs/cmu_twin_runs.py reads a finished run's case.toml and summary.json, pairs it with the measured trial of
-    its wheel, steering angle, slip and load, and gives the residual in the trial's standard deviations; a run not
-    steady is marked as giving no number."""
+    """docs/cmu_twin_runs.py reads finished runs as typed results, pairs each with the measured trial of its wheel,
+    steering angle, slip and load, and gives the residual in the trial's standard deviations; a run not steady is
+    marked as giving no number; a slip ramp gives a record per stage, at the stage's slip."""
+    from result_files import summary, write_result
+
+    from wheelsoil.cases.schema import load_case
     from wheelsoil.validation.measured import load_cmu_trials
 
     table = _load("cmu_twin_runs")
     data = load_cmu_trials(Path(measured_dir) / "cmu_3d_terramechanics")
     k = int(np.flatnonzero((data.grouser_height > 0) & (data.slip_angle == 45.0)
                            & (np.abs(data.travel_slip - 0.5) <= 0.05))[0])
-    quantity = lambda mean: {"mean": mean, "ci95": 0.5}  # noqa: E731
+    rig = [f"test.slip={data.travel_slip[k]}", "test.slip_angle=45.0", f"test.load={data.load[k]}",
+           "test.drive_time=20.0", "case.seed=1"]
+    dp = data.responses["drawbar_pull"][k] + 2 * data.std["drawbar_pull"][k]
+    run = lambda slip, steady: summary(  # noqa: E731
+        slip, steady=steady, window=(2.0, 9.0), tread_slip=(0.5, 0.0), vertical_force=(20.0, 0.0),
+        drawbar_pull=(dp, 0.25), lateral_force=(-1.0, 0.25), tread_sinkage=(0.03, 0.25))
     for name, steady in (("a1", True), ("b2", False)):
-        folder = tmp_path / "cmu-some-sweep" / "cases" / name
-        folder.mkdir(parents=True)
-        folder.joinpath("case.toml").write_text(
-            f'[case]\nseed = 1\n[soil]\nlength = 0.3\nwidth = 0.2\ndepth = 0.1\n[wheel]\npreset = "cmu-k10-grouser"\n'
-            f'[test]\nslip = {data.travel_slip[k]}\nslip_angle = 45.0\nload = {data.load[k]}\ndrive_time = 20.0\n')
-        summary = {"steady": steady, "window": [2.0, 9.0], "tread_slip": {"mean": 0.5},
-                   "vertical_force": {"mean": 20.0},
-                   "drawbar_pull": quantity(data.responses["drawbar_pull"][k] + 2 * data.std["drawbar_pull"][k]),
-                   "lateral_force": quantity(-1.0), "tread_sinkage": quantity(0.03)}
-        folder.joinpath("summary.json").write_text(json.dumps(
-            {"summary": summary, "run": {"wall_seconds": 100.0, "simulated_seconds": 9.0}}))
+        write_result(tmp_path / "cmu-some-sweep" / "cases" / name, load_case("cmu-grouser", rig), [run(0.5, steady)])
+    ramp = load_case("cmu-grouser", rig + ["protocol.stages=[{slip = 0.9}]"])
+    write_result(tmp_path / "cmu-some-sweep" / "cases" / "c3", ramp, [run(data.travel_slip[k], True), run(0.9, True)])
     records = table.finished_runs(tmp_path)
     table.pair_with_trials(records, data)
-    assert [r["case_hash"] for r in records] == ["a1", "b2"]
-    assert all(r["trial"] is not None for r in records)
+    assert [(r["case_hash"], r.get("stage")) for r in records] == [("a1", None), ("b2", None), ("c3", 0), ("c3", 1)]
+    assert [r["slip"] for r in records[2:]] == [data.travel_slip[k], 0.9]
+    assert records[0]["trial"] is not None and records[0]["drawbar_pull"] == {"mean": dp, "ci95": 0.5}
     lines = table.markdown(records)
     assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
     assert "**no**" in lines[3]
+    assert " / +2.0 | " in lines[4] and ", +0.900, " in lines[5]
 
 
 def test_a_calibration_candidate_reruns_only_its_plates_in_another_box(tmp_path, monkeypatch, measured_dir):
@@ -148,6 +150,10 @@ def test_seed004_like_reads_changes_in_the_seeds_terms(tmp_path):
     """docs/seed004_like.py on synthetic runs whose drawbar pull falls by a known 40 % from 5 to 20 deg at every
     slip, and is 80 % lower at 1/6 g: it gives those averages, leaves out slips whose runs are not steady and reports
     nothing below four slips."""
+    from result_files import summary, write_result
+
+    from wheelsoil.cases.schema import load_case
+
     table = _load("seed004_like")
     cases = tmp_path / "cases"
     k = 0
@@ -156,14 +162,12 @@ def test_seed004_like_reads_changes_in_the_seeds_terms(tmp_path):
             for slip in table.SLIPS:
                 dp = 1000.0 * slip * (0.6 if angle == 20.0 else 1.0) * (0.2 if gravity == "moon" else 1.0)
                 steady = not (gravity == "moon" and slip >= 0.4)  # three moon slips are not steady
-                folder = cases / f"c{k}"
-                folder.mkdir(parents=True)
+                case = load_case("smoke-1g-steer", [f"soil.gravity={gravity}", f"test.load={load}",
+                                                    f"test.slip_angle={angle}", f"test.slip={slip}"])
+                stage = summary(slip, steady=steady, drawbar_pull=(dp, 5.0), lateral_force=(-dp, 5.0),
+                                sinkage=(0.05, 1e-3))
+                write_result(cases / f"c{k}", case, [stage])
                 k += 1
-                folder.joinpath("case.toml").write_text(
-                    f'[soil]\ngravity = "{gravity}"\n[test]\nload = {load}\nslip_angle = {angle}\nslip = {slip}\n')
-                q = {"drawbar_pull": {"mean": dp, "sem": 5.0}, "lateral_force": {"mean": -dp, "sem": 5.0},
-                     "sinkage": {"mean": 0.05, "sem": 1e-3}}
-                folder.joinpath("summary.json").write_text(json.dumps({"summary": {"steady": steady, **q}}))
     runs = table.read_runs(tmp_path)
     factors = {"earth": dict.fromkeys(table.QUANTITIES, 2.0), "moon": dict.fromkeys(table.QUANTITIES, 1.0)}
     steer = table.averaged(runs, factors, (*table.EARTH_3000, 5.0), (*table.EARTH_3000, 20.0), "drawbar_pull",

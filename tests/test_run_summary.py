@@ -74,14 +74,15 @@ def test_the_default_protocol_is_its_five_steps_and_skips_the_wind_up_of_a_rigid
     the controller only, so a rigid wheel goes from the spin-up straight to the drive, which begins at that moment."""
     from types import SimpleNamespace
 
-    from wheelsoil.coupling.protocol import DEFAULT_PROTOCOL, advance
+    from wheelsoil.coupling.protocol import DEFAULT_PROTOCOL, advance, protocol_for
     from wheelsoil.coupling.protocol_state import PHASES, ProtocolState
 
-    assert [s.name for s in DEFAULT_PROTOCOL] == list(PHASES[1:-1])
+    assert [s.name for s in DEFAULT_PROTOCOL] == ["lower", "settle", "spin-up", "wind-up", "drive"]
+    assert {s.name for s in protocol_for(2)} == set(PHASES[1:-1])  # a further stage adds the ramp
     for rigid, windup, expected in ((True, "controller", "drive"), (False, "none", "drive"),
                                     (False, "controller", "wind-up")):
         spec = SimpleNamespace(rigid=rigid, windup=windup, spin_up_time=0.5, average_time=1.0)
-        bench = SimpleNamespace(spec=spec, pitch=0.5, batch_rate=2.0)
+        bench = SimpleNamespace(spec=spec, stage_spec=spec, pitch=0.5, batch_rate=2.0)
         state = ProtocolState(phase="spin-up", t_spin=1.0)
         assert not advance(DEFAULT_PROTOCOL, bench, state, {}, 1.2)  # the ramp goes on
         assert state.phase == "spin-up"

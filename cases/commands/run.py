@@ -98,9 +98,12 @@ def cmd(args) -> int:
     out = args.out or Path("wheelsoil-output") / case.name
     outcome = run_case(case, out, arch=args.arch, resume=args.resume, restart=args.restart,
                        progress=console.is_terminal, console=console)
-    s = outcome.testbed_result.summary
-    for line in summary_lines(s):
-        console.print(line)
+    stages = outcome.testbed_result.stages
+    for k, s in enumerate(stages):
+        if len(stages) > 1:
+            console.print(f"[bold]stage {k + 1} of {len(stages)}[/bold] (commanded slip {s.commanded_slip:g})")
+        for line in summary_lines(s):
+            console.print(line)
     info = outcome.testbed_result.info
     console.print(f"{info['wall_seconds']:.0f} s wall for {info['simulated_seconds']:.2f} s simulated; "
                   f"wrote {outcome.result_path} (+ .xdmf for ParaView), series.csv, summary.json, case.toml, "
