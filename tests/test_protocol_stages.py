@@ -13,6 +13,7 @@ import pytest
 
 from wheelsoil.coupling import protocol as protocol_module
 from wheelsoil.coupling.protocol import DEFAULT_PROTOCOL, advance, protocol_for, running_step
+from wheelsoil.coupling.kinematics import longitudinal_slip, rig_command
 from wheelsoil.coupling.protocol_state import ProtocolState
 from wheelsoil.coupling.rig import DriveStage, TestbedSpec, batch_rate, carriage_speed, check_fits, stage_spec
 from wheelsoil.coupling.run_summary import RunSummary
@@ -41,6 +42,7 @@ class StandInBench:
         self.stage_spec = stage_spec(self.spec, k)
         self.spin_command, self.travel_speed = carriage_speed(self.stage_spec, RADIUS)
         self.batch_rate = batch_rate(self.stage_spec.slip, self.stage_spec.angular_velocity, RADIUS)
+        self.slip_reference_speed = rig_command(self.stage_spec.slip, self.stage_spec.angular_velocity, RADIUS)[1]
         self.checks = 0
 
     def release(self) -> None:
@@ -204,3 +206,28 @@ def test_a_checkpoint_from_before_the_step_index_finds_its_step_by_name():
     assert running_step(staged, ProtocolState.from_dict(later.to_dict())) == 7
     with pytest.raises(ValueError, match="not in this protocol"):
         running_step(DEFAULT_PROTOCOL, later)
+
+
+def test_the_progress_line_names_the_phase_stage_and_tread_slip():
+    """The terminal's progress line (``Testbed.run(progress=True)``, what ``wheelsoil run`` shows in a terminal) reads
+    the typed protocol state: the phase, the stage of a slip ramp and the tread slip beside the commanded one."""
+    from wheelsoil.coupling.run_progress import RunProgress
+
+    spec = _spec(stages=(DriveStage(0.5),))
+    bench = StandInBench(spec)
+    bench.enter_stage(1)
+    bench.protocol_state = ProtocolState(phase="drive", step=7, stage=1, t_release=0.1, t_spin=1.0)
+    bench.scene = SimpleNamespace(time=1.5)
+    omega_t = bench.spin_command * 0.9  # the tread turns slower than the hub (winding up)
+    bench.rows = {"drawbar_pull": [3.0], "vertical_force": [100.0], "torque": [5.0], "sinkage": [0.01],
+                  "tread_omega": [omega_t] * 20}
+    bar = RunProgress(bench)
+    try:
+        bar.update()
+        line = bar.bar.tasks[0].description
+    finally:
+        bar.stop()
+    tread = longitudinal_slip(bench.slip_reference_speed, omega_t, RADIUS)
+    assert tread < 0.5 and f"tread slip {tread:.3f} (commanded 0.5)" in line  # a wound-up tread slips less
+    assert line.startswith("drive 2/2") and "t = 1.500 s" in line
+    assert bar.bar.tasks[0].total == 1000  # the running stage's longest drive sets the bar's end
