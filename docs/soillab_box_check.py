@@ -6,6 +6,11 @@ value; a larger change is the box's error, reported beside every plate number. E
 two boxes' ``plate.json`` (``pressure``: the simulated pressure at each sinkage); a box whose run has not finished is
 said to be missing.
 
+The depth-or-density question (``docs/soillab/box/density.sh``, fixed before its runs): the lab's box poured to the
+deep box's packing (``density/plate``) against the deep box and the lab's box, at the same sinkages and 10 %: within
+10 % of the deep box everywhere and more than 10 % from the lab box somewhere, the density explains the depth doubling;
+within 10 % of the lab box everywhere, the depth does; otherwise both.
+
 Usage (from the repository root; seconds)::
 
     python docs/soillab_box_check.py --boxes docs/soillab/box
@@ -44,6 +49,24 @@ def judge(small: dict | None, big: dict | None) -> dict:
     return {"changes": changes, "verdict": verdict}
 
 
+def depth_or_density(lab: dict | None, deep: dict | None, dense: dict | None) -> dict:
+    """The denser lab box's relative differences from the deep box and from the lab box at :data:`SINKAGES` (each of
+    the denser box's pressure) and what they say (module docstring)."""
+    if lab is None or deep is None or dense is None:
+        return {"from_deep": None, "from_lab": None, "verdict": "not run yet"}
+    from_deep = [(dense[z] - deep[z]) / dense[z] for z in SINKAGES]
+    from_lab = [(dense[z] - lab[z]) / dense[z] for z in SINKAGES]
+    near_deep = all(abs(c) < ALLOWED for c in from_deep)
+    near_lab = all(abs(c) < ALLOWED for c in from_lab)
+    if near_deep and not near_lab:
+        verdict = "the density explains the depth doubling"
+    elif near_lab:
+        verdict = "the depth, not the density, stiffens the deep box"
+    else:
+        verdict = "both (neither box within 10 % everywhere)"
+    return {"from_deep": from_deep, "from_lab": from_lab, "verdict": verdict}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--boxes", default="docs/soillab/box")
@@ -61,8 +84,15 @@ def main(argv=None) -> int:
         verdicts.append({"doubled": what, "box": small, "doubled_box": big, **v})
         change = "–" if v["changes"] is None else " / ".join(f"{c:+.0%}" for c in v["changes"])
         lines.append(f"| {what} | {small} → {big} | {change} | {v['verdict']} |")
+    density = depth_or_density(pressures(boxes / "lab"), pressures(boxes / "deep"), pressures(boxes / "density" / "plate"))
+    lines += ["", "Depth or density (`density.sh`: the lab's box poured to the deep box's packing):", "",
+              "| denser lab box against | difference at 10 / 15 / 20 mm |", "|---|---|"]
+    for key, name in (("from_deep", "the deep box"), ("from_lab", "the lab's box")):
+        cell = "–" if density[key] is None else " / ".join(f"{c:+.0%}" for c in density[key])
+        lines.append(f"| {name} | {cell} |")
+    lines += ["", f"Verdict: {density['verdict']}."]
     (boxes / "check.md").write_text("\n".join(lines) + "\n")
-    (boxes / "check.json").write_text(json.dumps(verdicts, indent=1) + "\n")
+    (boxes / "check.json").write_text(json.dumps({"doublings": verdicts, "depth_or_density": density}, indent=1) + "\n")
     print("\n".join(lines))
     return 0
 

@@ -131,3 +131,16 @@ def test_a_soil_lab_checkpoint_of_no_samples_or_of_a_test_that_keeps_none_is_ref
              "--checkpoint-every = 0", ">= 1")
     _refused(["soil-lab", "shear", "--checkpoint-every", "5", "--out", str(tmp_path / "lab")], capsys,
              "--checkpoint-every = 5", "plate and wheel tests only")
+
+
+def test_a_box_for_a_soil_lab_test_with_its_own_apparatus_is_refused_and_the_poured_bed_takes_it(tmp_path, capsys):
+    from wheelsoil.cases.cli import build_parser
+    from wheelsoil.cases.commands import soil_lab
+
+    _refused(["soil-lab", "repose", "--box", "0.6", "0.6", "0.12", "--out", str(tmp_path / "lab")], capsys,
+             "--box 0.6 0.6 0.12", "the repose test has its own apparatus")
+    _refused(["soil-lab", "shear", "--box", "0.6", "0.6", "0.12", "--out", str(tmp_path / "lab")], capsys,
+             "the shear test has its own apparatus")
+    args = build_parser().parse_args(["soil-lab", "poured", "--box", "0.3", "0.3", "0.24", "--seeds", "0"])
+    _, bed, _ = soil_lab._specs(args)
+    assert (bed.length, bed.width, bed.depth) == (0.3, 0.3, 0.24)  # a poured bed in the box asked for

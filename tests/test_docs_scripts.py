@@ -202,7 +202,21 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     box("wide", 1 / 0.95)  # the wide box's pressure 5 % above: passes
     box("deep", 1.25)      # 20 % of the deep box's: fails
     assert check.main(["--boxes", str(tmp_path)]) == 0
-    verdicts = json.loads((tmp_path / "check.json").read_text())
+    verdicts = json.loads((tmp_path / "check.json").read_text())["doublings"]
     assert [v["verdict"] for v in verdicts][:2] == ["passes", "fails (20% against 10%)"]
     assert verdicts[0]["changes"] == pytest.approx([0.05] * 3)
     assert verdicts[2]["verdict"] == verdicts[3]["verdict"] == "not run yet"
+    assert json.loads((tmp_path / "check.json").read_text())["depth_or_density"]["verdict"] == "not run yet"
+    # depth or density: the lab's box poured denser carries the deep box's pressure (within 4 %), 20 % above the lab's
+    (tmp_path / "density").mkdir()
+    box("density/plate", 1.2)
+    check.main(["--boxes", str(tmp_path)])
+    density = json.loads((tmp_path / "check.json").read_text())["depth_or_density"]
+    assert density["verdict"] == "the density explains the depth doubling"
+    assert density["from_deep"] == pytest.approx([(1.2 - 1.25) / 1.2] * 3)
+    box("density/lab-like", 1.05)  # within 10 % of the lab box's: the depth stiffens the deep box
+    assert check.depth_or_density(check.pressures(tmp_path / "lab"), check.pressures(tmp_path / "deep"),
+                                  check.pressures(tmp_path / "density" / "lab-like"))["verdict"].startswith("the depth")
+    box("density/between", 1.12)  # 10.7 % from both: both
+    assert check.depth_or_density(check.pressures(tmp_path / "lab"), check.pressures(tmp_path / "deep"),
+                                  check.pressures(tmp_path / "density" / "between"))["verdict"].startswith("both")

@@ -54,7 +54,8 @@ def add_parser(sub) -> None:
     t.add_argument("--plate", type=float, nargs="+", default=list(soil_lab.PLATE_DIAMETERS),
                    help="plate diameters [m] (plate)")
     t.add_argument("--box", type=float, nargs=3, default=None, metavar=("LENGTH", "WIDTH", "DEPTH"),
-                   help="the pressing box [m] (plate, wheel; default the parameter set's)")
+                   help="the bed's box [m] (poured, plate, wheel; default the parameter set's: the plate's for "
+                        "the poured bed)")
     t.add_argument("--speed", type=float, default=soil_lab.PRESS["speed"], help="pressing speed [m/s]")
     t.add_argument("--max-sinkage", type=float, default=soil_lab.PRESS["max_sinkage"], help="pressing depth [m]")
     t.add_argument("--wheel", choices=("smooth", "grouser"), default="smooth", help="the CMU wheel (wheel)")
@@ -112,8 +113,12 @@ def _specs(args):
     from wheelsoil import soillab
 
     seeds = args.seeds or ([0] if args.test in ("plate", "wheel", "shear") else list(soil_lab.POURED_SEEDS))
+    if args.box and args.test in ("repose", "shear"):
+        raise WheelsoilInputError(f"--box {' '.join(f'{v:g}' for v in args.box)}: the {args.test} test has its own "
+                                  "apparatus; --box sets the bed of the poured, plate and wheel tests")
     if args.test == "poured":
-        return seeds, _bed_spec(args, soil_lab.PLATE_BOX, seeds[0]), None
+        box = dict(zip(("length", "width", "depth"), args.box)) if args.box else soil_lab.PLATE_BOX
+        return seeds, _bed_spec(args, box, seeds[0]), None
     if args.test == "repose":
         spec = soillab.ReposeSpec(seeds=tuple(seeds))
         return seeds, _bed_spec(args, soil_lab.PLATE_BOX, seeds[0]), spec
