@@ -44,7 +44,9 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
         ``"metal"``. Asking for a different backend after the first initialisation is an error, because
         every array already allocated lives on the first one.
     cpu_threads:
-        Number of CPU threads for parallel loops (default: all cores).
+        Number of CPU threads for parallel loops (default: ``WHEELSOIL_CPU_THREADS``, else all cores). Runs that
+        share the cores (a sweep's workers, a campaign beside a run) go faster in all with fewer threads each
+        (``benchmarks/README.md``, "Several runs sharing the cores"); ``wheelsoil batch`` sets it for its workers.
 
     Returns the name of the backend actually in use.
     """
@@ -71,6 +73,8 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
         debug=debug,
         log_level=ti.WARN,
     )
+    if cpu_threads is None:
+        cpu_threads = threads_from_environment()
     if cpu_threads is not None:
         kwargs["cpu_max_num_threads"] = int(cpu_threads)
     t0 = time.perf_counter()
@@ -88,6 +92,27 @@ def init(arch: str | None = None, *, debug: bool = False, cpu_threads: int | Non
         threads.pin_worker_threads(int(ti.lang.impl.current_cfg().cpu_max_num_threads))
     _state["arch"] = requested
     return requested
+
+
+#: The environment variable that sets the CPU backend's worker threads (:func:`init`).
+CPU_THREADS_VAR = "WHEELSOIL_CPU_THREADS"
+
+
+def threads_from_environment() -> int | None:
+    """The worker threads ``WHEELSOIL_CPU_THREADS`` asks for (None: unset or empty); anything but a whole number from
+    1 to the machine's cores is refused, naming the value."""
+    raw = os.environ.get(CPU_THREADS_VAR, "").strip()
+    if not raw:
+        return None
+    cores = os.cpu_count() or 1
+    try:
+        value = int(raw)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= cores:
+        raise WheelsoilInputError(f"{CPU_THREADS_VAR}={raw!r}: give a whole number of CPU threads from 1 to this "
+                                  f"machine's {cores} cores (or leave it unset: all of them)")
+    return value
 
 
 def current_arch() -> str | None:
