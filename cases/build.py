@@ -33,7 +33,7 @@ from .case_model import CaseFile
 #: Wheel keys that replace the preset's value when given (None: keep the preset's).
 WHEEL_KEYS = ("element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
               "spoke_bow", "spoke_model", "grouser_count", "grouser_height", "grouser_thickness", "grouser_angle",
-              "hub_mass")
+              "hub_mass", "side_walls")
 
 
 def bed_spec(case: CaseFile) -> BedSpec:

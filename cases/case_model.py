@@ -163,6 +163,9 @@ class Wheel(_Section):
     grouser_angle: Optional[float] = _q(None, "deg", "grouser angle to the axle (chevron half-angle)",
                                         _WHEEL["grouser_angle"])
     hub_mass: Optional[float] = _q(None, "kg", "hub mass (with the rig's moving parts)", _WHEEL["hub_mass"])
+    side_walls: Optional[bool] = Field(None, description="close the wheel with a flat disc on each side, from the "
+                                                         "tread to the hub (an open wheel driven deep fills with soil "
+                                                         "through its sides); every preset's own is open")
     youngs_modulus: Optional[float] = _q(None, "Pa", "wheel material Young's modulus; at most 1.2e12 Pa (diamond)",
                                          _MATERIAL["youngs_modulus"])
     poisson_ratio: Optional[float] = _q(None, "1", "wheel material Poisson's ratio", _MATERIAL["poisson_ratio"])
@@ -307,4 +310,6 @@ class CaseFile(BaseModel):
             data["output"].pop("steady_drift_confidence")
         if not data["protocol"]["stages"]:
             data.pop("protocol")
+        if data["wheel"]["side_walls"] is None:
+            data["wheel"].pop("side_walls")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

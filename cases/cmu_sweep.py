@@ -56,6 +56,20 @@ CANDIDATES = {
         "The chosen soil's particles at x0.64 of the calibration's (x0.8 of the twin's): 4.1-6.1 mm, the grousers\n"
         "1.0 mean grain high instead of 0.8; about twice the particles and an hour a case on 2 cores."),
 }
+#: Candidates that change the twin's wheel, not its soil: name -> (case overrides, why). Chosen after the twin's runs
+#: at 45 and 90 deg had been seen, so they are judged on steering angles no twin run has seen
+#: (:data:`WHEEL_CANDIDATE_TRIALS`), against the twin's own runs of those trials (the ``cmu-held-out-angles`` sweep).
+WHEEL_CANDIDATES = {
+    "closed-wheel": (
+        {"wheel.side_walls": True},
+        "The wheel closed by a flat disc on each side (wheel.side_walls). The twin's wheel is an open drum: in its\n"
+        "steady runs soil filled 7 % (45 deg) and 39 % (90 deg) of the drum's volume as solid grains, entering\n"
+        "through the open sides and, at 90 deg, streaming through the wheel along its axle instead of being pushed\n"
+        "aside. The lab's own model gives the wheel a side face that bulldozes the soil (R_b.m)."),
+}
+#: The trials a wheel candidate and its baseline run: the grousered wheel at 30 and 75 deg, driving 0.5, first repeat.
+WHEEL_CANDIDATE_TRIALS = {"grouser": (30.0, 75.0)}
+WHEEL_CANDIDATE_SLIPS = (0.5,)
 #: The trials a candidate runs: the grousered wheel at 0 deg (the trial whose twin showed the overprediction) and at
 #: the held-out 45 and 90 deg (no twin result seen when this was fixed), driving 0.5 and 0.9, first repeat.
 CANDIDATE_TRIALS = {"grouser": (0.0, 45.0, 90.0)}
@@ -158,7 +172,7 @@ def sweep_toml(rows: list[dict], description: str, common: dict | None = None) -
     def table(name: str, values: dict) -> list[str]:
         lines = [name]
         for key, value in values.items():
-            text = f'"{value}"' if isinstance(value, str) else repr(value)
+            text = f'"{value}"' if isinstance(value, str) else str(value).lower() if isinstance(value, bool) else repr(value)
             lines.append(f'"{key}" = {text}')
         return lines
 
@@ -190,6 +204,15 @@ def write_presets(folder: str | Path, presets: str | Path | None = None) -> list
                        f"DEM-side candidate '{name}' of the CMU twin (cases/cmu_sweep.py CANDIDATES; docs/cmu-twin/README.md).\n"
                        f"{why}\nThe grousered wheel at 0 deg (seen) and 45 and 90 deg (held out), driving 0.5 and 0.9.",
                        overrides))
+    held_out = _pick(rows, WHEEL_CANDIDATE_TRIALS, WHEEL_CANDIDATE_SLIPS)
+    sweeps.append(("cmu-held-out-angles", held_out, "The twin as it is at steering angles none of its runs has seen "
+                   "(cases/cmu_sweep.py WHEEL_CANDIDATE_TRIALS):\nthe baseline of the wheel candidates, the grousered "
+                   "wheel at 30 and 75 deg, driving 0.5.", None))
+    for name, (overrides, why) in WHEEL_CANDIDATES.items():
+        sweeps.append((f"cmu-candidate-{name}", held_out,
+                       f"Wheel candidate '{name}' of the CMU twin (cases/cmu_sweep.py WHEEL_CANDIDATES; "
+                       f"docs/cmu-twin/README.md).\n{why}\nThe grousered wheel at 30 and 75 deg (held out), driving "
+                       "0.5.", overrides))
     for name, chosen, what, overrides in sweeps:
         path = presets / f"{name}.toml"
         path.write_text(sweep_toml(chosen, f"{what}\n{common}", overrides))

@@ -5,7 +5,9 @@ the twin's own runs of the same trials (the subset, ``RUNS/cmu-trials-subset``) 
 wheel at 45 and 90 deg), the error being the RMS of the drawbar pull's and the lateral force's residuals over their
 spread in every measured trial, and the twin's run-to-run spread from the replicas (the subset's run of
 ``REPLICA_CONDITION`` and ``RUNS/cmu-replicas``): ``wheelsoil.validation.candidate_test.judge_candidate``. Unsteady
-runs are left out (``load_sweep_summary``). Writes ``OUT/<name>.md`` and ``OUT/<name>.json``.
+runs are left out (``load_sweep_summary``). The wheel candidates (``WHEEL_CANDIDATES``, chosen after the 45 and 90 deg
+runs had been seen) are judged the same way on the trials at 30 and 75 deg, against the twin's runs of those trials
+(``RUNS/cmu-held-out-angles``). Writes ``OUT/<name>.md`` and ``OUT/<name>.json``.
 
 Usage (from the repository root; seconds)::
 
@@ -22,6 +24,8 @@ import numpy as np
 MEASURED = Path("..") / "shared" / "data" / "measured" / "cmu_3d_terramechanics"
 #: The held-out steering angles (the trials at 0 deg showed the overprediction the candidates were chosen for).
 HELD_OUT_ANGLES = (45.0, 90.0)
+#: The wheel candidates' held-out angles and baseline sweep (no twin run at those angles was seen when they were fixed).
+WHEEL_HELD_OUT_ANGLES, WHEEL_BASELINE = (30.0, 75.0), "cmu-held-out-angles"
 
 
 def _sweep(folder: Path):
@@ -83,7 +87,7 @@ def report(name: str, verdict, why: str) -> str:
 
 
 def main(argv=None) -> int:
-    from wheelsoil.cases.cmu_sweep import CANDIDATES
+    from wheelsoil.cases.cmu_sweep import CANDIDATES, WHEEL_CANDIDATES
     from wheelsoil.validation.candidate_test import judge_candidate
     from wheelsoil.validation.measured import load_cmu_trials
 
@@ -93,14 +97,16 @@ def main(argv=None) -> int:
     parser.add_argument("--data", type=Path, default=MEASURED)
     args = parser.parse_args(argv)
     data = load_cmu_trials(args.data)
-    held = (data.grouser_height > 0) & np.isin(data.slip_angle, HELD_OUT_ANGLES)
-    baseline = _sweep(args.runs / "cmu-trials-subset")
     reps = replicas(args.runs, data)
     args.out.mkdir(parents=True, exist_ok=True)
-    for name, (overrides, why) in CANDIDATES.items():
+    judged = [(name, entry, "cmu-trials-subset", HELD_OUT_ANGLES) for name, entry in CANDIDATES.items()]
+    judged += [(name, entry, WHEEL_BASELINE, WHEEL_HELD_OUT_ANGLES) for name, entry in WHEEL_CANDIDATES.items()]
+    for name, (overrides, why), baseline_sweep, angles in judged:
+        held = (data.grouser_height > 0) & np.isin(data.slip_angle, angles)
+        baseline = _sweep(args.runs / baseline_sweep)
         candidate = _sweep(args.runs / f"cmu-candidate-{name}")
         if baseline is None or candidate is None:
-            print(f"{name}: no steady runs yet in {args.runs} (cmu-trials-subset, cmu-candidate-{name})")
+            print(f"{name}: no steady runs yet in {args.runs} ({baseline_sweep}, cmu-candidate-{name})")
             continue
         v = judge_candidate(data, baseline, candidate, held, replicas=reps)
         (args.out / f"{name}.md").write_text(report(name, v, why.replace("\n", " ")))

@@ -50,6 +50,7 @@ def finished_runs(runs: Path) -> list[dict]:
             seen.add(folder.resolve())
             result = load_result(folder)
             case = result.case
+            fill = result_drum_fill(result)  # the last frame's: the last stage's
             for k, s in enumerate(result.stages):
                 record = {"sweep": sweep.name, "case_hash": folder.name, "wheel": case.wheel.preset,
                           "seed": case.case.seed, "slip": s.commanded_slip, "slip_angle": case.test.slip_angle,
@@ -64,8 +65,33 @@ def finished_runs(runs: Path) -> list[dict]:
                     record[q] = {"mean": s.quantity(q).mean, "ci95": s.quantity(q).ci95}
                 record["tread_slip"] = s.tread_slip.mean
                 record["vertical_force"] = s.vertical_force.mean
+                record["side_walls"] = bool(case.wheel.side_walls)
+                record["drum_fill"] = fill
                 out.append(record)
     return out
+
+
+def drum_fill(positions: np.ndarray, radii: np.ndarray, hub: np.ndarray, slip_angle: float, radius: float,
+              width: float, tread_thickness: float) -> float:
+    """The share of an open wheel's drum (inside the tread, between its two side planes) that grains fill: the solid
+    volume of the spheres [m^3] whose centres lie in it over the drum's volume, pi (r - t)^2 b. The wheel is yawed by
+    -slip_angle [deg] about z (the testbed's convention), its hub at ``hub``."""
+    beta = math.radians(-slip_angle)
+    heading, axle = np.array([math.cos(beta), math.sin(beta), 0.0]), np.array([-math.sin(beta), math.cos(beta), 0.0])
+    p = np.asarray(positions, float) - np.asarray(hub, float)
+    inside = (np.abs(p @ axle) < 0.5 * width) & (np.hypot(p @ heading, p[:, 2]) < radius - tread_thickness)
+    solid = float(np.sum(4.0 / 3.0 * np.pi * np.asarray(radii, float)[inside] ** 3))
+    return solid / (np.pi * (radius - tread_thickness) ** 2 * width)
+
+
+def result_drum_fill(result) -> float:
+    """:func:`drum_fill` of a finished run's last frame (NaN for a run that kept no frame)."""
+    if not len(result.frame_times):
+        return math.nan
+    frame, wheel, s = result.frame(-1), result.wheel, result.series
+    hub = np.array([s["hub_x"][-1], s["hub_y"][-1], s["hub_z"][-1]])
+    return drum_fill(frame["position"], frame["radius"], hub, result.case.test.slip_angle, wheel.radius, wheel.width,
+                     wheel.tread_thickness)
 
 
 def pair_with_trials(records: list[dict], data) -> None:
@@ -90,8 +116,8 @@ def markdown(records: list[dict]) -> list[str]:
     """The table: one row per run, its measured trial and residuals in trial standard deviations."""
     head = ("| sweep | wheel, β, slip, load, seed, drive | steady (window) | " +
             " | ".join(f"{label} [{unit}]: twin (95 %) / trial (std) / residual in trial stds"
-                       for _, label, _, unit in QUANTITIES.values()) + " | wall / simulated |")
-    lines = [head, "|" + "---|" * (4 + len(QUANTITIES))]
+                       for _, label, _, unit in QUANTITIES.values()) + " | soil in the drum | wall / simulated |")
+    lines = [head, "|" + "---|" * (5 + len(QUANTITIES))]
     for r in records:
         steady = (f"yes ({r['window'][0]:.2f}–{r['window'][1]:.2f} s)" if r["steady"]
                   else f"**no** (window {r['window'][0]:.2f}–{r['window'][1]:.2f} s, not a number)")
@@ -105,12 +131,14 @@ def markdown(records: list[dict]) -> list[str]:
             elif trial is not None:  # the trials' sinkage is from the start position, the twin's from the surface
                 cell += f" / {scale * trial['mean']:.1f} (from the start position) / –"
             cells.append(cell)
-        wheel = r["wheel"].replace("cmu-k10-", "")
+        wheel = r["wheel"].replace("cmu-k10-", "") + (", closed" if r.get("side_walls") else "")
         bin_note = "" if r["bin"] == [0.3, 0.2, 0.1] else f", bin {r['bin'][1]:g} × {r['bin'][2]:g} m"
+        fill = r.get("drum_fill", math.nan)
+        drum = "–" if not np.isfinite(fill) else ("closed" if r.get("side_walls") else f"{fill:.0%}")
         lines.append(f"| {r['sweep'].replace('cmu-', '')} | {wheel}, {r['slip_angle']:g}°, {r['slip']:+.3f}, "
                      f"{r['load']:.2f} N, seed {r['seed']}, {r['drive_time']:g} s drive{bin_note} | {steady} | "
                      + " | ".join(cells) +
-                     f" | {r['wall_seconds']:.0f} s / {r['simulated_seconds']:.2f} s |")
+                     f" | {drum} | {r['wall_seconds']:.0f} s / {r['simulated_seconds']:.2f} s |")
     return lines
 
 
@@ -138,7 +166,8 @@ def main(argv=None) -> int:
              "`result.h5` (read as typed results); the rules that judge them are in [the twin's README](../README.md). "
              f"{len(records)} finished runs, {steady} of them steady. The intervals are each run's own (the steady-"
              "state detector's 95 %), without the run-to-run spread; a run not steady gives no number and is listed "
-             "for information. Signs are wheelsoil's (the lateral force opposes the lateral slip); the residual is "
+             "for information. *Soil in the drum*: the solid volume of the grains inside the open wheel's drum (inside the "
+             "tread, between its side planes) over the drum's volume, in the run's last frame. Signs are wheelsoil's (the lateral force opposes the lateral slip); the residual is "
              "(twin − trial) / the trial's std. The trials' sinkage is measured from the wheel's start position, the "
              "twin's tread sinkage from the levelled surface, so they are shown and not compared.", "",
              *markdown(records), ""]

@@ -7,9 +7,12 @@ The wheel (axle along y, wheel plane x-z, centre at the origin) is made of
   (each row spans a band of the width and has its own angular offset, so the ExoMars-like layout of
   three loops per side plus three inner loops rotated by 60 deg is a preset); modelled as shells or
   as beams;
+* optional **side walls** (``side_walls``): a flat annular disc on each side, from the tread's edge down to the
+  hub radius, of the tread's thickness, closing the wheel as a disc wheel is closed (an open wheel driven deep fills
+  with soil through its sides, and at a steering angle the soil streams through it);
 * a rigid **hub**: the spokes' inner nodes are tied to it (see :class:`~.structure.Structure`).
 
-The contact surface is the tread and grousers. Element size is the resolution parameter; the angular
+The contact surface is the tread, the grousers and the side walls. Element size is the resolution parameter; the angular
 and width grids are refined until every grouser, spoke and row boundary falls on a grid line.
 """
 
@@ -30,7 +33,9 @@ from .material import SEED004_WHEEL, Material
 from .mesh import StructureMesh
 from .shapes import grid_triangles
 
-PARTS = ["tread", "grouser", "spoke"]
+PARTS = ["tread", "grouser", "spoke", "side"]
+#: The parts the soil touches (indices into :data:`PARTS`): tread, grousers and side walls, not the spokes.
+CONTACT_PARTS = (0, 1, 3)
 
 
 @dataclass(frozen=True)
@@ -64,6 +69,7 @@ class WheelGeometry:
     element_size: float = 0.02
     hub_mass: float = 0.0
     nominal_load: float = 0.0
+    side_walls: bool = False
     name: str = "wheel"
 
     RANGES: ClassVar[dict[str, Range]] = {
@@ -153,7 +159,14 @@ def estimated_elements(g: WheelGeometry) -> int:
     for row in g.spoke_rows:
         cols = max(1, round((row.y_max - row.y_min) * n_width))
         n += g.spokes_per_row * (2 * n_s * cols if g.spoke_model == "shell" else n_s * (cols + 1))
+    if g.side_walls:
+        n += 2 * 2 * n_around * _side_rings(g)
     return int(n)
+
+
+def _side_rings(g: WheelGeometry) -> int:
+    """Rings of a side wall's mesh from the tread's mid-surface radius to the hub radius (at least two)."""
+    return max(2, math.ceil((g.tread_mid_radius - g.hub_radius) / g.element_size))
 
 
 def check_mesh_memory(g: WheelGeometry, available: int, share: float = 0.5) -> int:
@@ -260,9 +273,25 @@ def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray
                     for a in range(n_s):
                         beams.append((ids[a, jc], ids[a + 1, jc]))
                         beam_sec.append(rectangular_section(strip_width, g.spoke_thickness))
+    # ---- side walls: an annulus on each side, from the tread's edge nodes in rings down to the hub radius
+    if g.side_walls:
+        n_r = _side_rings(g)
+        radii = r_mid - (r_mid - g.hub_radius) * np.arange(1, n_r + 1) / n_r
+        for j in (0, n_width):
+            rr, pp_s = np.meshgrid(radii, phi, indexing="ij")
+            new = np.c_[rr.ravel() * np.cos(pp_s.ravel()), np.full(rr.size, y[j]), rr.ravel() * np.sin(pp_s.ravel())]
+            ids = np.vstack([[tread_node(i, j) for i in range(n_around)],
+                             n_nodes + np.arange(n_r * n_around).reshape(n_r, n_around)])  # (ring, angle)
+            nodes.append(new)
+            n_nodes += len(new)
+            hub_nodes.extend(ids[-1].tolist())
+            local = grid_triangles(n_around, n_r, periodic_u=True)  # angles (closed around) x rings
+            tri.append(ids.T.ravel()[local])
+            thick.append(np.full(len(local), g.tread_thickness))
+            part.append(np.full(len(local), 3, np.int64))
     triangles = np.vstack(tri)
     n_tri = len(triangles)
-    surface = np.flatnonzero(np.concatenate(part) <= 1)
+    surface = np.flatnonzero(np.isin(np.concatenate(part), CONTACT_PARTS))
     beam_arr = np.asarray(beams, np.int64).reshape(-1, 2)
     mesh = StructureMesh(
         nodes=np.vstack(nodes),

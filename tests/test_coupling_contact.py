@@ -184,3 +184,41 @@ def test_the_interface_counts_in_the_time_step():
     scene.add_interaction(WheelContact(st, LUNAR_SOIL_SIMULANT, SOIL_STEEL))
     assert scene.stable_time_step().stable < before
     assert scene.time_step <= scene.stable_time_step().stable
+
+
+@pytest.mark.parametrize("side_walls", [False, True])
+def test_a_grain_moving_along_the_axle_enters_an_open_wheel_and_bounces_off_a_closed_one(side_walls):
+    """``WheelGeometry.side_walls``: a sphere shot along the axle at the wheel's side, between the hub and the tread,
+    passes into an open wheel (its drum: the tread, grousers and side walls are the contact surface, not the spokes)
+    and rebounds from a closed one's side disc, as from a wall (elastic pair: the speed it came with, reversed); the
+    discs close the annulus from the tread to the hub (their area, to the polygon's round-off)."""
+    from dataclasses import replace
+
+    from wheelsoil.flexwheel.geometry import CMU_K10_GROUSER
+
+    geometry = replace(CMU_K10_GROUSER, side_walls=side_walls)
+    mesh, hub = build_wheel_mesh(geometry)
+    side = mesh.part[: len(mesh.triangles)] == mesh.part_names.index("side")
+    tri, x = mesh.triangles[side], mesh.nodes
+    area = 0.5 * np.linalg.norm(np.cross(x[tri[:, 1]] - x[tri[:, 0]], x[tri[:, 2]] - x[tri[:, 0]]), axis=1).sum()
+    annulus = 2 * math.pi * (geometry.tread_mid_radius ** 2 - geometry.hub_radius ** 2)
+    assert area == pytest.approx(annulus * side_walls, rel=2e-3)
+    assert np.isin(np.flatnonzero(side), mesh.surface).all()
+    st = Structure(mesh, rigid=True, hub_nodes=hub)
+    st.drive_hub(velocity=(0, 0, 0), angular_velocity=(0, 0, 0))
+    scene = Scene((-0.08, -0.08, -0.08), (0.08, 0.08, 0.08), gravity=(0, 0, 0))
+    r, v0 = 0.003, 0.5
+    y0 = 0.5 * geometry.width + 0.5 * geometry.tread_thickness + r + 1e-4
+    scene.add_spheres(np.array([[0.0, y0, -0.04]]), np.array([r]), velocities=np.array([[0.0, -v0, 0.0]]))
+    elastic = PairProperties(restitution=1.0, static_friction=0.0, rolling_friction=0.0)
+    scene.add_interaction(WheelContact(st, LUNAR_SOIL_SIMULANT, elastic))
+    inside = 0.5 * geometry.width - 0.5 * geometry.tread_thickness - r  # wholly past the side plane, in the drum
+    steps = int(round(1e-3 / scene.time_step))  # 1 ms between checks, at the scene's stable step
+    for _ in range(40):  # up to 40 ms: 20 mm of travel at 0.5 m/s
+        scene.step(steps)
+        if scene.positions[0, 1] < inside or scene.velocities[0, 1] > 0.0 and scene.contact_count == 0:
+            break
+    if side_walls:
+        assert scene.velocities[0, 1] == pytest.approx(v0, rel=1e-3) and scene.positions[0, 1] > y0 - r
+    else:
+        assert scene.positions[0, 1] < inside and scene.velocities[0, 1] == pytest.approx(-v0, rel=1e-12)

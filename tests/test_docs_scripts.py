@@ -95,6 +95,23 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
     assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
     assert "**no**" in lines[3]
     assert " / +2.0 | " in lines[4] and ", +0.900, " in lines[5]
+    assert all(np.isnan(r["drum_fill"]) and not r["side_walls"] for r in records)  # stand-ins keep no frame
+    assert all(line.endswith(" | – | 1 s / 1.00 s |") for line in lines[2:])
+
+
+def test_the_drum_fill_counts_the_grains_inside_an_open_wheel():
+    """docs/cmu_twin_runs.py's drum fill: the grains whose centres lie inside the tread and between the side planes of
+    a wheel yawed by the steering angle, their solid volume over the drum's (at 90 deg the axle lies along the bin)."""
+    table = _load("cmu_twin_runs")
+    hub, r = np.array([0.1, 0.1, 0.08]), 0.003
+    along_axle = {0.0: np.array([0.0, 1.0, 0.0]), 90.0: np.array([1.0, 0.0, 0.0])}
+    for angle, axle in along_axle.items():
+        positions = hub + np.array([0.01 * axle + [0, 0, -0.03],   # in the drum
+                                    0.03 * axle + [0, 0, -0.03],   # beyond a side plane
+                                    [0.0, 0.0, -0.06],             # below the tread
+                                    -0.02 * axle])                 # in the drum, beside the hub
+        fill = table.drum_fill(positions, np.full(4, r), hub, angle, radius=0.058, width=0.05, tread_thickness=0.002)
+        assert fill == pytest.approx(2 * (4 / 3 * np.pi * r ** 3) / (np.pi * 0.056 ** 2 * 0.05), rel=1e-12), angle
 
 
 def test_a_calibration_candidate_reruns_only_its_plates_in_another_box(tmp_path, monkeypatch, measured_dir):
