@@ -219,23 +219,14 @@ def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray
         return (i % n_around) * nw1 + j
 
     # ---- grousers: radial plates outside the tread
-    if g.grouser_count:
-        n_g = max(1, math.ceil(g.grouser_height / h))
-        for k in range(g.grouser_count):
-            i = int(round(((g.grouser_angle / 360.0 + k / g.grouser_count) % 1.0) * n_around)) % n_around
-            c, s = math.cos(phi[i]), math.sin(phi[i])
-            # grouser runs from the tread mid-surface to the outer radius + grouser height
-            heights = np.linspace(0.0, g.grouser_height + 0.5 * g.tread_thickness, n_g + 1)[1:]
-            rr = r_mid + heights
-            rr_g, yy_g = np.meshgrid(rr, y, indexing="ij")
-            new = np.c_[rr_g.ravel() * c, yy_g.ravel(), rr_g.ravel() * s]
-            ids = np.vstack([[tread_node(i, j) for j in range(nw1)], n_nodes + np.arange(n_g * nw1).reshape(n_g, nw1)])
-            nodes.append(new)
-            n_nodes += len(new)
-            local = grid_triangles(n_g, n_width)
-            tri.append(ids.ravel()[local])
-            thick.append(np.full(len(local), g.grouser_thickness))
-            part.append(np.ones(len(local), np.int64))
+    for k in range(g.grouser_count):
+        i = int(round(((g.grouser_angle / 360.0 + k / g.grouser_count) % 1.0) * n_around)) % n_around
+        new, local = _grouser(g, phi[i], y, [tread_node(i, j) for j in range(nw1)], n_nodes)
+        nodes.append(new)
+        n_nodes += len(new)
+        tri.append(local)
+        thick.append(np.full(len(local), g.grouser_thickness))
+        part.append(np.ones(len(local), np.int64))
     # ---- spokes
     hub_nodes = []
     beams, beam_sec = [], []
@@ -273,22 +264,15 @@ def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray
                     for a in range(n_s):
                         beams.append((ids[a, jc], ids[a + 1, jc]))
                         beam_sec.append(rectangular_section(strip_width, g.spoke_thickness))
-    # ---- side walls: an annulus on each side, from the tread's edge nodes in rings down to the hub radius
     if g.side_walls:
-        n_r = _side_rings(g)
-        radii = r_mid - (r_mid - g.hub_radius) * np.arange(1, n_r + 1) / n_r
         for j in (0, n_width):
-            rr, pp_s = np.meshgrid(radii, phi, indexing="ij")
-            new = np.c_[rr.ravel() * np.cos(pp_s.ravel()), np.full(rr.size, y[j]), rr.ravel() * np.sin(pp_s.ravel())]
-            ids = np.vstack([[tread_node(i, j) for i in range(n_around)],
-                             n_nodes + np.arange(n_r * n_around).reshape(n_r, n_around)])  # (ring, angle)
+            new, local, inner = _side_wall(g, phi, y[j], [tread_node(i, j) for i in range(n_around)], n_nodes)
             nodes.append(new)
             n_nodes += len(new)
-            hub_nodes.extend(ids[-1].tolist())
-            local = grid_triangles(n_around, n_r, periodic_u=True)  # angles (closed around) x rings
-            tri.append(ids.T.ravel()[local])
+            hub_nodes.extend(inner)
+            tri.append(local)
             thick.append(np.full(len(local), g.tread_thickness))
-            part.append(np.full(len(local), 3, np.int64))
+            part.append(np.full(len(local), PARTS.index("side"), np.int64))
     triangles = np.vstack(tri)
     n_tri = len(triangles)
     surface = np.flatnonzero(np.isin(np.concatenate(part), CONTACT_PARTS))
@@ -307,6 +291,32 @@ def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray
     )
     assert n_tri == len(mesh.triangles)
     return mesh, np.unique(np.asarray(hub_nodes, np.int64))
+
+
+def _grouser(g: WheelGeometry, angle: float, y: np.ndarray, root: list[int], first: int):
+    """One grouser: a radial plate at ``angle`` [rad] across the width (nodes at ``y`` [m]) from the tread's nodes
+    ``root`` at the mid-surface out to the outer radius plus the grouser height. Returns its new nodes (first
+    numbered ``first``) and its triangles (node indices)."""
+    n_g, nw1 = max(1, math.ceil(g.grouser_height / g.element_size)), len(y)
+    heights = np.linspace(0.0, g.grouser_height + 0.5 * g.tread_thickness, n_g + 1)[1:]
+    rr, yy = np.meshgrid(g.tread_mid_radius + heights, y, indexing="ij")
+    new = np.c_[rr.ravel() * math.cos(angle), yy.ravel(), rr.ravel() * math.sin(angle)]
+    ids = np.vstack([root, first + np.arange(n_g * nw1).reshape(n_g, nw1)])
+    return new, ids.ravel()[grid_triangles(n_g, nw1 - 1)]
+
+
+def _side_wall(g: WheelGeometry, phi: np.ndarray, y: float, edge: list[int], first: int):
+    """One side wall: an annulus in the plane at ``y`` [m], from the tread's edge nodes ``edge`` (one per angle of
+    ``phi`` [rad]) in rings down to the hub radius. Returns its new nodes (first numbered ``first``), its triangles
+    (node indices) and its innermost ring's nodes (tied to the hub)."""
+    n_r, n_around = _side_rings(g), len(phi)
+    r_mid = g.tread_mid_radius
+    radii = r_mid - (r_mid - g.hub_radius) * np.arange(1, n_r + 1) / n_r
+    rr, pp = np.meshgrid(radii, phi, indexing="ij")
+    new = np.c_[rr.ravel() * np.cos(pp.ravel()), np.full(rr.size, y), rr.ravel() * np.sin(pp.ravel())]
+    ids = np.vstack([edge, first + np.arange(n_r * n_around).reshape(n_r, n_around)])  # (ring, angle)
+    local = grid_triangles(n_around, n_r, periodic_u=True)  # angles (closed around) x rings
+    return new, ids.T.ravel()[local], ids[-1].tolist()
 
 
 def from_parameters(values: dict) -> WheelGeometry:
