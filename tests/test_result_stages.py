@@ -1,7 +1,7 @@
 """A drive of several stages (``[protocol]`` ``stages``, a slip ramp) in the case file, the result file and the sweep
 tables, without the engine: the section's round trip and errors, each stage's summary stored and read back
-(``/stages/<k>``), and one sweep row per stage at the stage's slip. A one-stage case keeps its hash, its case text
-and its result layout. The engine's staged run is in ``test_coupling_testbed.py`` (slow tier)."""
+(``/stages/<k>``), and one sweep row per stage at the stage's slip. A one-stage case keeps its hash and its result
+layout, and its case text has no ``[protocol]`` section. The engine's staged run is in ``test_coupling_testbed.py`` (slow tier)."""
 
 import math
 
