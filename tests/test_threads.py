@@ -120,5 +120,6 @@ def test_the_cpu_thread_count_changes_the_speed_not_the_result():
         runs[value] = json.loads(done.stdout.strip().splitlines()[-1])
         assert runs[value]["threads"] == int(value)
     one, many = runs.values()
+    assert one["threads"] == 1 < many["threads"]
     assert one["contacts"] > 100  # colliding spheres, not spheres apart (188 at the time of writing)
     assert one["x"] == many["x"] and one["w"] == many["w"]
