@@ -96,19 +96,18 @@ def main(argv=None) -> int:
         ap.error("--processes, --rounds and --steps must be at least 1")
     _bed(args.case)  # prepared once, so that every process loads it from the cache
     names = list(SETTINGS)
-    rounds = []
+    rounds, ratios = [], []
     for k in range(args.rounds):
+        pair = {}
         for setting in (names if k % 2 == 0 else names[::-1]):
-            r = one_round(setting, args.processes, args)
+            r = pair[setting] = one_round(setting, args.processes, args)
             rounds.append(r)
             print(f"round {k + 1}, {setting}: {r['aggregate_particle_steps_per_s'] / 1e6:.2f} M particle-steps/s "
                   f"(threads {r['threads']}, {r['cpu_per_wall']:.2f} cores busy, overlap {r['overlap']:.0%})",
                   flush=True)
+        # the round ran both settings back to back: one worker each over the default
+        ratios.append(pair[names[1]]["aggregate_particle_steps_per_s"] / pair[names[0]]["aggregate_particle_steps_per_s"])
     best = {s: max(r["aggregate_particle_steps_per_s"] for r in rounds if r["setting"] == s) for s in names}
-    ratios = [b["aggregate_particle_steps_per_s"] / a["aggregate_particle_steps_per_s"]
-              for a, b in zip(rounds[0::2], rounds[1::2])]
-    # each pair ran both settings back to back; the ratio is one worker each over the default
-    ratios = [r if rounds[2 * i]["setting"] == names[0] else 1.0 / r for i, r in enumerate(ratios)]
     report = {"case": args.case, "processes": args.processes, "steps": args.steps, "rounds": rounds,
               "best_M_particle_steps_per_s": {s: v / 1e6 for s, v in best.items()},
               "ratio_one_worker_over_default_per_round": ratios,

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from wheelsoil.coupling.rig import DriveStage, RigPlan, TestbedSpec, plan_rig
+from wheelsoil.coupling.rig import DriveStage, RigPlan, TestbedSpec, plan_rig, stage_spec
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, estimated_elements, preset
 from wheelsoil.granular.bed_spec import BedSpec, estimated_particles
 from wheelsoil.material import Material, PairProperties
@@ -118,16 +118,17 @@ class RunPlan:
         return self.rig.test
 
 
-def output_bytes(case: CaseFile, particles: int, elements: int) -> int:
+def output_bytes(case: CaseFile, test: TestbedSpec, particles: int, elements: int) -> int:
     """Upper estimate of a run's files [bytes]: its frames (at most one per sample; per particle position,
     velocity and radius, per wheel element about a node's position and deformation, 8 bytes each) over the
-    longest run (lowering allowed 2 s, settle, spin-up, the whole drive and every further stage's ramp and drive),
-    plus two checkpoints."""
-    t, o = case.test, case.output
-    total = 2.0 + t.settle_time + t.spin_up_time + t.drive_time
-    for st in case.protocol.stages:
-        total += (st.ramp_time if st.ramp_time is not None else t.spin_up_time) + (
-            st.drive_time if st.drive_time is not None else t.drive_time)
+    longest run of the rig ``test`` (lowering allowed 2 s, settle, and every stage's spin-up or ramp and whole drive,
+    :func:`~wheelsoil.coupling.rig.stage_spec`), plus two checkpoints."""
+    o = case.output
+    total = 2.0 + test.settle_time
+    for k in range(test.n_stages):
+        stage = stage_spec(test, k)
+        total += stage.spin_up_time
+        total += stage.drive_time
     frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
     per_frame = particles * 7 * 8 + elements * 6 * 8
     return frames * per_frame + 2 * particles * 30 * 8
@@ -138,4 +139,4 @@ def plan(case: CaseFile) -> RunPlan:
     (:class:`~wheelsoil.errors.WheelsoilInputError`) name the case keys and values."""
     rig = plan_rig(*specs(case))
     particles, elements = estimated_particles(rig.bed), estimated_elements(rig.wheel)
-    return RunPlan(rig, particles, elements, output_bytes(case, particles, elements))
+    return RunPlan(rig, particles, elements, output_bytes(case, rig.test, particles, elements))

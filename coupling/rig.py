@@ -345,10 +345,10 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
         return PatchGeometry.for_wheel(bed.length, outer, shift, bed.diameter_max).check(spec.start_x)
     # every stage's longest drive and ramp at that stage's carriage speed (the ramp's at the faster of its ends)
     stages = [stage_spec(spec, k) for k in range(spec.n_stages)]
-    speed = max(abs(carriage_speed(st, wheel.radius)[1]) for st in stages)
-    travel = sum(abs(carriage_speed(st, wheel.radius)[1]) * st.drive_time
-                 + max(abs(carriage_speed(st, wheel.radius)[1]), abs(carriage_speed(prev, wheel.radius)[1]))
-                 * st.spin_up_time for prev, st in zip([stages[0]] + stages[:-1], stages))
+    speeds = [abs(carriage_speed(st, wheel.radius)[1]) for st in stages]
+    speed = max(speeds)
+    travel = sum(v * st.drive_time + max(v, before) * st.spin_up_time
+                 for st, v, before in zip(stages, speeds, speeds[:1] + speeds[:-1]))
     start_x = spec.start_x if spec.start_x is not None else outer + 0.1
     if start_x - outer < 0 or start_x + travel + outer > bed.length:
         raise WheelsoilInputError(

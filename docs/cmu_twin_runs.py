@@ -75,9 +75,11 @@ def drum_fill(positions: np.ndarray, radii: np.ndarray, hub: np.ndarray, slip_an
               width: float, tread_thickness: float) -> float:
     """The share of an open wheel's drum (inside the tread, between its two side planes) that grains fill: the solid
     volume of the spheres [m^3] whose centres lie in it over the drum's volume, pi (r - t)^2 b. The wheel is yawed by
-    -slip_angle [deg] about z (the testbed's convention), its hub at ``hub``."""
-    beta = math.radians(-slip_angle)
-    heading, axle = np.array([math.cos(beta), math.sin(beta), 0.0]), np.array([-math.sin(beta), math.cos(beta), 0.0])
+    -slip_angle [deg] about z (the testbed's convention, ``coupling.kinematics.yaw_matrix``), its hub at ``hub``."""
+    from wheelsoil.coupling.kinematics import yaw_matrix
+
+    yaw = yaw_matrix(math.radians(-slip_angle))
+    heading, axle = yaw[:, 0], yaw[:, 1]
     p = np.asarray(positions, float) - np.asarray(hub, float)
     inside = (np.abs(p @ axle) < 0.5 * width) & (np.hypot(p @ heading, p[:, 2]) < radius - tread_thickness)
     solid = float(np.sum(4.0 / 3.0 * np.pi * np.asarray(radii, float)[inside] ** 3))
