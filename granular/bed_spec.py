@@ -51,9 +51,11 @@ class BedSpec:
     periodic: the bin is periodic along x (no end walls; :class:`~.scene.Scene` ``periodic_x``): a soil
         patch that a moving-patch testbed can shift without end (``wheelsoil.coupling.patch``).
     pour_friction_factor: the sliding and rolling friction of the soil--soil and soil--wall pairs are multiplied
-        by this while the bed is poured, settled and levelled [-], in [0, 1]. 1 (default) pours with the particles'
-        own friction, a loose packing; 0 pours frictionless spheres, the densest packing. The bed keeps
-        ``pair`` and ``wall_pair`` for every test made on it.
+        by this while the bed is poured, settled and levelled [-], in [0, 3]. 1 (default) pours with the particles'
+        own friction, a loose packing; below 1 the spheres slide into a denser packing (0 pours frictionless
+        spheres, the densest); above 1 they lock sooner, a looser one (how a deep bed, which its own weight packs
+        denser, is poured to a shallow bed's packing). The bed keeps ``pair`` and ``wall_pair`` for every test made
+        on it.
     """
 
     length: float = smoke.SOIL["length"]
@@ -80,7 +82,7 @@ class BedSpec:
         "length": positive(), "width": positive(), "depth": positive(), "diameter_min": positive(),
         "diameter_max": positive(), "max_settle_time": positive(), "seed": Range(lo=0, integer=True),
         "overfill": Range(1.0, 3.0), "kinetic_energy_threshold": positive(), "time_step": positive(),
-        "pour_friction_factor": Range(0.0, 1.0),
+        "pour_friction_factor": Range(0.0, 3.0),
     }
     UNITS: ClassVar[dict[str, str]] = {
         "length": "m", "width": "m", "depth": "m", "diameter_min": "m", "diameter_max": "m", "max_settle_time": "s",

@@ -119,9 +119,9 @@ def test_rows_whose_motion_the_model_cannot_be_told_are_refused(change, needle, 
     _refused(["validate", str(path), "--report", str(tmp_path / "report")], capsys, needle)
 
 
-def test_a_pour_friction_factor_outside_zero_to_one_is_refused(tmp_path, capsys):
-    _refused(["soil-lab", "plate", "--pour-friction-factor", "2", "--out", str(tmp_path / "lab")], capsys,
-             "pour_friction_factor = 2.0", "0 <= pour_friction_factor <= 1")
+def test_a_pour_friction_factor_outside_zero_to_three_is_refused(tmp_path, capsys):
+    _refused(["soil-lab", "plate", "--pour-friction-factor", "3.5", "--out", str(tmp_path / "lab")], capsys,
+             "pour_friction_factor = 3.5", "0 <= pour_friction_factor <= 3")
     _refused(["prepare-bed", "smoke-1g-steer", "--set", "soil.pour_friction_factor=-0.5", "--out",
               str(tmp_path / "bed")], capsys, "soil.pour_friction_factor")
 

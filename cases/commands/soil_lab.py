@@ -45,7 +45,7 @@ def add_parser(sub) -> None:
                         "directional torque) or epsd (elastic-plastic spring-dashpot, holds a torque at rest)")
     g.add_argument("--pour-friction-factor", type=float, default=1.0,
                    help="sliding and rolling friction times this while the bed is poured: 1 a loose pour, 0 the "
-                        "densest [-]")
+                        "densest, above 1 looser (at most 3) [-]")
     g.add_argument("--gravity", type=gravity_argument, default=GRAVITY_PRESETS["earth"],
                    help="'earth', 'moon' or m/s^2 (the sand's tests: earth)")
     g.add_argument("--seeds", type=int, nargs="+", default=None,
