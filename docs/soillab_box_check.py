@@ -11,6 +11,11 @@ deep box's packing (``density/plate``) against the deep box and the lab's box, a
 10 % of the deep box everywhere and more than 10 % from the lab box somewhere, the density explains the depth doubling;
 within 10 % of the lab box everywhere, the depth does; otherwise both.
 
+The depth doubling at equal packing (``docs/soillab/box/depth.sh``, fixed before its runs): the deep box poured looser,
+to the lab box's packing (``depth/plate``), against the lab's box by the box check's rule (a change below 10 % of the
+deeper box's pressure at every sinkage: the lab box's depth holds the plate at equal packing); beside it, the two
+packings and the looser deep box against the deep box (the density's effect at equal depth).
+
 Usage (from the repository root; seconds)::
 
     python docs/soillab_box_check.py --boxes docs/soillab/box
@@ -67,6 +72,21 @@ def depth_or_density(lab: dict | None, deep: dict | None, dense: dict | None) ->
     return {"from_deep": from_deep, "from_lab": from_lab, "verdict": verdict}
 
 
+def depth_at_equal_packing(lab: dict | None, deep: dict | None, loose_deep: dict | None) -> dict:
+    """The looser deep box judged as a depth doubling of the lab's box (:func:`judge`), and its relative difference
+    from the deep box poured as loose as the particles' own friction lets it, (p_loose_deep - p_deep) / p_loose_deep."""
+    doubling = judge(lab, loose_deep)
+    from_deep = (None if deep is None or loose_deep is None
+                 else [(loose_deep[z] - deep[z]) / loose_deep[z] for z in SINKAGES])
+    return {**doubling, "from_deep": from_deep}
+
+
+def packing(folder: Path) -> float | None:
+    """The packing fraction of the bed the plate was pressed in (``folder/plate.json``; None: not run yet)."""
+    path = folder / "plate.json"
+    return json.loads(path.read_text())["runs"][0]["packing_fraction"] if path.is_file() else None
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--boxes", default="docs/soillab/box")
@@ -91,8 +111,23 @@ def main(argv=None) -> int:
         cell = "–" if density[key] is None else " / ".join(f"{c:+.0%}" for c in density[key])
         lines.append(f"| {name} | {cell} |")
     lines += ["", f"Verdict: {density['verdict']}."]
+    equal = depth_at_equal_packing(pressures(boxes / "lab"), pressures(boxes / "deep"),
+                                   pressures(boxes / "depth" / "plate"))
+    equal["packing"] = {name: packing(boxes / folder) for name, folder in
+                        (("lab", "lab"), ("deep", "deep"), ("looser_deep", "depth/plate"))}
+    pk = equal["packing"]
+    fmt = (lambda v: "–" if v is None else f"{v:.4f}")
+    lines += ["", "Depth at equal packing (`depth.sh`: the deep box poured looser, to the lab box's packing; packing "
+              f"lab {fmt(pk['lab'])}, deep {fmt(pk['deep'])}, looser deep {fmt(pk['looser_deep'])}):", "",
+              "| looser deep box against | change at 10 / 15 / 20 mm |", "|---|---|"]
+    for key, name in (("changes", "the lab's box (the depth doubling at equal packing)"),
+                      ("from_deep", "the deep box (the density at equal depth)")):
+        cell = "–" if equal[key] is None else " / ".join(f"{c:+.0%}" for c in equal[key])
+        lines.append(f"| {name} | {cell} |")
+    lines += ["", f"Verdict on the depth doubling at equal packing: {equal['verdict']}."]
     (boxes / "check.md").write_text("\n".join(lines) + "\n")
-    (boxes / "check.json").write_text(json.dumps({"doublings": verdicts, "depth_or_density": density}, indent=1) + "\n")
+    (boxes / "check.json").write_text(json.dumps({"doublings": verdicts, "depth_or_density": density,
+                                                  "depth_at_equal_packing": equal}, indent=1) + "\n")
     print("\n".join(lines))
     return 0
 

@@ -208,12 +208,13 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     box not yet run is said to be missing."""
     check = _load("soillab_box_check")
 
-    def box(name, scale):
+    def box(name, scale, packing=0.52):
         (tmp_path / name).mkdir()
         rows = [{"diameter_m": 0.1, "sinkage_m": z, "simulated_Pa": 1e6 * z * scale}
                 for z in (0.005, 0.01, 0.015, 0.02)]
         rows.append({"diameter_m": 0.06, "sinkage_m": 0.01, "simulated_Pa": 1.0})  # another plate: not read
-        (tmp_path / name / "plate.json").write_text(json.dumps({"pressure": rows}))
+        (tmp_path / name / "plate.json").write_text(json.dumps({"pressure": rows,
+                                                                "runs": [{"packing_fraction": packing}]}))
 
     box("lab", 1.0)
     box("wide", 1 / 0.95)  # the wide box's pressure 5 % above: passes
@@ -237,3 +238,14 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     box("density/between", 1.12)  # 10.7 % from both: both
     assert check.depth_or_density(check.pressures(tmp_path / "lab"), check.pressures(tmp_path / "deep"),
                                   check.pressures(tmp_path / "density" / "between"))["verdict"].startswith("both")
+    # the depth doubling at equal packing: the deep box poured looser carries 8 % more than the lab's box (passes) and
+    # 14 % less than the deep box poured loose; its packing is reported beside
+    assert json.loads((tmp_path / "check.json").read_text())["depth_at_equal_packing"]["verdict"] == "not run yet"
+    (tmp_path / "depth").mkdir()
+    box("depth/plate", 1 / 0.92, packing=0.515)
+    check.main(["--boxes", str(tmp_path)])
+    equal = json.loads((tmp_path / "check.json").read_text())["depth_at_equal_packing"]
+    assert equal["verdict"] == "passes" and equal["changes"] == pytest.approx([0.08] * 3)
+    assert equal["from_deep"] == pytest.approx([(1 / 0.92 - 1.25) * 0.92] * 3)
+    assert equal["packing"] == {"lab": 0.52, "deep": 0.52, "looser_deep": 0.515}
+    assert "Verdict on the depth doubling at equal packing: passes." in (tmp_path / "check.md").read_text()
