@@ -23,7 +23,7 @@ def wheel_speeds(slip, slip_angle_deg, travel_slip) -> WheelSpeeds:
     return WheelSpeeds(*(np.where(given, getattr(travel, k), getattr(heading, k)) for k in ("rim", "along", "across")))
 
 
-def tangential_displacement(radius, theta_f, theta, speeds: WheelSpeeds, soil_flow):
+def tangential_displacement(radius, theta_f, theta, speeds: WheelSpeeds, soil_flow, sin_theta=None):
     """Shear displacement j_x [m] along the rim (rows: conditions; columns: theta [rad]; theta_f [rad] and the soil
     flow eta per condition): seed 003 eq. 11 in velocity components, j = int_theta^theta_f (slip velocity)
     d theta' / omega,
@@ -31,10 +31,12 @@ def tangential_displacement(radius, theta_f, theta, speeds: WheelSpeeds, soil_fl
         j_x = r ((theta_f - theta)(1 - eta) r omega - v_x (sin theta_f - sin theta)) / (r omega),
 
     which with v_x = (1 - i) r omega (driving) or r omega / (1 + i) (braking) is eq. 12 on both branches, and stays
-    defined at 90 deg and, through :func:`_per_rim`, for omega = 0."""
+    defined at 90 deg and, through :func:`_per_rim`, for omega = 0. ``sin_theta``: sin(theta), where the caller has
+    it already (the same values; one pass over the quadrature points fewer)."""
     tf = theta_f[:, None]
     rim = speeds.rim[:, None]
-    rate = (tf - theta) * (1.0 - soil_flow[:, None]) * rim - speeds.along[:, None] * (np.sin(tf) - np.sin(theta))
+    sin_theta = np.sin(theta) if sin_theta is None else sin_theta
+    rate = (tf - theta) * (1.0 - soil_flow[:, None]) * rim - speeds.along[:, None] * (np.sin(tf) - sin_theta)
     return radius * _per_rim(rate, rim)
 
 
@@ -67,12 +69,14 @@ def janosi_hanamoto(strength, displacement, modulus):
     return strength * np.sign(displacement) * -np.expm1(-np.abs(displacement) / modulus)
 
 
-def resultant_shear(strength, jx, jy, k_x, speeds: WheelSpeeds, soil_flow, theta):
+def resultant_shear(strength, jx, jy, k_x, speeds: WheelSpeeds, soil_flow, theta, cos_theta=None):
     """The CMU lab's shear (``tau_t.m``, ``tau_l.m``; module docstring): strength [Pa] mobilised by sqrt(j_x^2 +
     j_y^2) / k_x [m / m] along the slip velocity. Rows: conditions (the wheel's speeds, soil flow eta); columns:
-    theta [rad]. Returns (tau_x, tau_y) [Pa], tau_y a magnitude (its sign is -sign(beta))."""
+    theta [rad] (``cos_theta``: its cosine where the caller has it). Returns (tau_x, tau_y) [Pa], tau_y a magnitude
+    (its sign is -sign(beta))."""
     # the slip velocity under the rim (v_jt.m, with the soil's own flow), in the speeds' units
-    v_t = (speeds.rim * (1.0 - soil_flow))[:, None] - speeds.along[:, None] * np.cos(theta)
+    cos_theta = np.cos(theta) if cos_theta is None else cos_theta
+    v_t = (speeds.rim * (1.0 - soil_flow))[:, None] - speeds.along[:, None] * cos_theta
     v_l = np.broadcast_to(np.abs(speeds.across)[:, None], v_t.shape)
     speed = np.hypot(v_t, v_l)
     mobilised = strength * -np.expm1(-np.hypot(jx, jy) / k_x) / np.where(speed > 0.0, speed, 1.0)

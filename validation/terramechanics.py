@@ -351,22 +351,24 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
     theta = np.concatenate([th_front, th_rear], axis=1)
     weight = np.concatenate([w_front, w_rear], axis=1)
-    stress_angle = np.concatenate([th_front, equivalent], axis=1)
-    sigma = k_pressure[:, None] * np.clip(np.cos(stress_angle) - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
+    # each point's sine and cosine once (every integral below takes them); the stress angle is theta ahead of theta_m
+    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
+    cos_stress = np.concatenate([cos_theta[:, :th_front.shape[1]], np.cos(equivalent)], axis=1)
+    sigma = k_pressure[:, None] * np.clip(cos_stress - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
     sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
     # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
     eta = np.clip(soil.soil_flow + soil.soil_flow_gravity * (1.0 - g / EARTH_GRAVITY), 0.0, 0.95)
-    jx = tangential_displacement(r, theta_f, theta, speeds, eta)
+    jx = tangential_displacement(r, theta_f, theta, speeds, eta, sin_theta)
     strength = np.broadcast_to(strength_cohesion, i.shape)[:, None] + sigma * np.broadcast_to(np.tan(phi), i.shape)[:, None]
     k_x = np.broadcast_to(shear_modulus, i.shape)[:, None]
     resultant = soil.shear_form == "resultant"
     if resultant:
         tau_x, tau_y = resultant_shear(strength, jx, lateral_displacement(r, theta_f, theta, speeds), k_x, speeds, eta,
-                                       theta)
+                                       theta, cos_theta)
     else:
         tau_x = janosi_hanamoto(strength, jx, k_x)
-    fz = r * b * np.sum(weight * (tau_x * np.sin(theta) + sigma * np.cos(theta)), axis=1)
+    fz = r * b * np.sum(weight * (tau_x * sin_theta + sigma * cos_theta), axis=1)
     grousers = bool(wheel.grouser_count and wheel.grouser_height > 0.0 and soil.grouser_scale > 0.0)
     if grousers:
         gx, gz, gt = grouser_forces(soil, wheel, theta_f, theta_r, g, density, cohesion)
@@ -377,7 +379,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         shear_modulus_y = np.broadcast_to(shear_modulus_y, i.shape)[:, None]
         tau_y = janosi_hanamoto(strength, lateral_displacement(r, theta_f, theta, speeds), shear_modulus_y)
 
-    fx = r * b * np.sum(weight * (tau_x * np.cos(theta) - sigma * np.sin(theta)), axis=1)
+    fx = r * b * np.sum(weight * (tau_x * cos_theta - sigma * sin_theta), axis=1)
     torque = r * r * b * np.sum(weight * tau_x, axis=1)
     f_lateral = r * b * np.sum(weight * tau_y, axis=1)
     if soil.sidewall_scale > 0.0:
