@@ -5,7 +5,8 @@ For each sweep folder ``RUNS/cmu-*`` (the subset, the candidates, the replicas, 
 that has finished (its ``result.h5``, read as a typed result): the wheel, steering angle, commanded slip, load and
 seed of the case it ran; whether the steady-state detector found it steady and over which window; the steady (or, where not
 steady, the window's) means of the drawbar pull, the lateral force and the tread sinkage with their 95 % intervals
-(the detector's own: one run's, without the run-to-run spread the replicas measure); and the measured trial of the
+(the detector's own: one run's, without the run-to-run spread the replicas measure), the sinkage beside the trial's
+as :data:`SINKAGE_REFERENCE` says; and the measured trial of the
 same wheel, steering angle and load (each trial's load is its own) with its mean and standard deviation, in wheelsoil's
 signs (``wheelsoil.validation.measured.load_cmu_trials``). A run that is not steady gives no number (rule 2 of the
 README); it is listed, marked, for information.
@@ -32,6 +33,20 @@ MEASURED = Path("..") / "shared" / "data" / "measured" / "cmu_3d_terramechanics"
 QUANTITIES = {"drawbar_pull": ("drawbar_pull", "drawbar pull", 1.0, "N"),
               "lateral_force": ("lateral_force", "lateral force", 1.0, "N"),
               "tread_sinkage": ("sinkage", "tread sinkage", 1e3, "mm")}
+#: How the two sinkages compare (the table's header says it). The trials' is the lab's: the carriage's travel since the
+#: trial's start plus the 31.5 mm its scripts take as the wheel's sinkage at the start position
+#: (``raw-data-processing/read_ft_speed_data.m``, ``Z_zero``), one value per trial; the lab's own model fit uses it as
+#: the model's sinkage (``terramechanics/a_b_tuning_optimization_wrapper.m``, ``h0``). It reads as sinkage below the
+#: surface: the free-rolling trials at 0 deg give 14-16 mm, and the static press of the same wheels at their loads
+#: (22-26 N) reaches 12-15 mm from first contact (``force_displacement/wheel_sinkage.csv``). The twin's tread sinkage is
+#: the rim's lowest point below the levelled surface; a grousered wheel first touches with its 5 mm grouser tips, so
+#: the references may differ by up to the grouser height, and a difference within that is not resolved.
+SINKAGE_REFERENCE = ("The trials' sinkage is the lab's (its scripts add the 31.5 mm they take as the wheel's sinkage at "
+                     "its start to the carriage's travel; the free-rolling trials at 0° give 14–16 mm where the static "
+                     "press of the same wheels at their loads reaches 12–15 mm, so it reads as sinkage below the "
+                     "surface, as the lab's model fit uses it); the twin's tread sinkage is the rim's lowest point "
+                     "below the levelled surface. The grousered wheel first touches with its 5 mm grouser tips, so a "
+                     "difference within 5 mm is not resolved; the trials give one sinkage each, no std.")
 
 
 def finished_runs(runs: Path) -> list[dict]:
@@ -118,7 +133,8 @@ def markdown(records: list[dict]) -> list[str]:
     """The table: one row per run, its measured trial and residuals in trial standard deviations."""
     head = ("| sweep | wheel, β, slip, load, seed, drive | steady (window) | " +
             " | ".join(f"{label} [{unit}]: twin (95 %) / trial (std) / residual in trial stds"
-                       for _, label, _, unit in QUANTITIES.values()) + " | soil in the drum | wall / simulated |")
+                       if q != "tread_sinkage" else f"{label} [{unit}]: twin (95 %) / trial / twin − trial"
+                       for q, (_, label, _, unit) in QUANTITIES.items()) + " | soil in the drum | wall / simulated |")
     lines = [head, "|" + "---|" * (5 + len(QUANTITIES))]
     for r in records:
         steady = (f"yes ({r['window'][0]:.2f}–{r['window'][1]:.2f} s)" if r["steady"]
@@ -130,8 +146,8 @@ def markdown(records: list[dict]) -> list[str]:
             if trial is not None and q != "tread_sinkage":
                 z = (r[q]["mean"] - trial["mean"]) / trial["std"] if trial["std"] > 0 else math.nan
                 cell += f" / {scale * trial['mean']:+.2f} ({scale * trial['std']:.2f}) / {z:+.1f}"
-            elif trial is not None:  # the trials' sinkage is from the start position, the twin's from the surface
-                cell += f" / {scale * trial['mean']:.1f} (from the start position) / –"
+            elif trial is not None:  # one value per trial (no std): the difference in mm, within SINKAGE_REFERENCE
+                cell += f" / {scale * trial['mean']:.1f} / {scale * (r[q]['mean'] - trial['mean']):+.1f} mm"
             cells.append(cell)
         wheel = r["wheel"].replace("cmu-k10-", "") + (", closed" if r.get("side_walls") else "")
         bin_note = "" if r["bin"] == [0.3, 0.2, 0.1] else f", bin {r['bin'][1]:g} × {r['bin'][2]:g} m"
@@ -170,8 +186,7 @@ def main(argv=None) -> int:
              "state detector's 95 %), without the run-to-run spread; a run not steady gives no number and is listed "
              "for information. *Soil in the drum*: the solid volume of the grains inside the open wheel's drum (inside the "
              "tread, between its side planes) over the drum's volume, in the run's last frame. Signs are wheelsoil's (the lateral force opposes the lateral slip); the residual is "
-             "(twin − trial) / the trial's std. The trials' sinkage is measured from the wheel's start position, the "
-             "twin's tread sinkage from the levelled surface, so they are shown and not compared.", "",
+             "(twin − trial) / the trial's std. " + SINKAGE_REFERENCE, "",
              *markdown(records), ""]
     write_markdown_and_json(out / "runs.md", "\n".join(lines), out / "runs.json",
                             {"runs": records, "provenance": provenance()}, default=float)
