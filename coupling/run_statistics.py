@@ -64,6 +64,8 @@ def summarise_window(rows: dict, state: SteadyState, k0: int, k1: int, *, period
     t = rows["t"]
     quantities = {}
     for q in STEADY_QUANTITIES:
+        if q not in rows:  # a series recorded before the quantity was (the force balance's): no statistics
+            continue
         y = rows[q][k0:k1]
         st = state.stats.get(q)
         if st is None and len(state.bounds) > 2 and (state.bounds[-1], state.bounds[0]) == (k0, k1):

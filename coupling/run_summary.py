@@ -14,6 +14,8 @@ import math
 from dataclasses import dataclass, fields
 from typing import ClassVar
 
+from .force_balance import BALANCE_UNITS
+
 #: Series recorded at every sample, with units.
 SERIES_UNITS = {
     "t": "s",
@@ -37,11 +39,13 @@ SERIES_UNITS = {
     "hub_y": "m",
     "hub_z": "m",
     "contacts": "1",
+    **BALANCE_UNITS,
 }
 #: Quantities whose drift the steady-state detector checks (the tread slip is checked on its own).
 STEADY_CHECKED = ("drawbar_pull", "lateral_force", "vertical_force", "torque", "sinkage")
 #: Quantities averaged over the steady window.
-STEADY_QUANTITIES = STEADY_CHECKED + ("tread_sinkage", "slip", "slip_angle", "tread_slip_angle", "wind_up")
+STEADY_QUANTITIES = STEADY_CHECKED + ("tread_sinkage", "slip", "slip_angle", "tread_slip_angle", "wind_up",
+                                       "vertical_force_applied", "balance_residual")
 #: Every quantity a summary holds: the averaged ones and the tread slip.
 SUMMARY_QUANTITIES = STEADY_QUANTITIES + ("tread_slip",)
 
@@ -120,6 +124,8 @@ class RunSummary:
     slip_angle: QuantityStats = _MISSING
     tread_slip_angle: QuantityStats = _MISSING
     wind_up: QuantityStats = _MISSING
+    vertical_force_applied: QuantityStats = _MISSING
+    balance_residual: QuantityStats = _MISSING
     tread_slip: QuantityStats = _MISSING
 
     QUANTITIES: ClassVar[tuple[str, ...]] = SUMMARY_QUANTITIES

@@ -40,6 +40,10 @@ Protocol:
    since the spin-up ended (then the summary says the run is not steady, and why). ``stop_when_steady=False``
    drives the whole ``drive_time``.
 
+Every sample also records the wheel's vertical force balance (:mod:`.force_balance`): the soil's vertical force as
+the wheel's sub-steps applied it, the rig's load, the slide's damper and reaction, the structural damping's resultant,
+the weight, the momentum's rate and the residual of their sum (round-off when the record misses no force).
+
 Measured quantities (wheel frame, from the contact resultant, time-averaged over each sample interval):
 drawbar pull DP = F.x (net soil force along the heading), lateral force F.y, vertical force F.z,
 driving torque T = -M.y (the torque the motor supplies against the soil's moment about the axle),
@@ -65,6 +69,7 @@ from wheelsoil.granular.bed import Bed
 
 from .contact import WheelContact
 from .coupled_state import restore_coupled_state, take_coupled_state
+from .force_balance import BALANCE_UNITS, balance_row
 from .kinematics import TreadTracker, deformation, rig_command, yaw_matrix
 from .patch import MovingPatch
 from .placement import wheel_start_centre
@@ -132,6 +137,9 @@ class Testbed:
                                    rigid=spec.rigid, damping=spec.damping, gravity=bs.gravity, arch=arch)
         self.wheel_mass = float(self.structure.mass.sum() + wheel.hub_mass)
         self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / 0.1
+        self._slide_damper = 0.0  # the damper's force in the sample being taken [N]
+        #: the wheel's weight [N] (3-vector), as its integrator applies it (the force balance's G)
+        self.weight = self.structure.gravity_force()
         self.heading = self.yaw[:, 0]
         self.axle = self.yaw[:, 1]
         self.tracker = TreadTracker(mesh.nodes[self.tread_nodes], self.heading, self.axle,
@@ -194,7 +202,8 @@ class Testbed:
 
     def _apply_load(self, vertical_speed: float) -> None:
         """The rig's force on the released axle: W - m g down, and the damper against the vertical speed."""
-        push = -(self.spec.load - self.wheel_mass * self.gravity) - self.axle_damping * vertical_speed
+        self._slide_damper = -self.axle_damping * vertical_speed
+        push = -(self.spec.load - self.wheel_mass * self.gravity) + self._slide_damper
         self.structure.drive_hub(force=(0.0, 0.0, push))
 
     # ------------------------------------------------------------------ the run
@@ -256,14 +265,19 @@ class Testbed:
         s, loop, rows = self.spec, self._loop, self.rows
         self._set_drive()
         phase = loop.phase
+        self._slide_damper = 0.0
         if phase != "lower" and self.axle_damping > 0.0:
             self._apply_load(float(self.structure.hub_velocity[2]))
+        momentum = self.structure.linear_momentum()
+        self.structure.take_impulses()  # the force balance's accounts start with the interval
         self.scene.step(self.steps_per_sample)
         if self.patch is not None:
             self.patch.drop_thrown_out(self.scene)
         interval = self.steps_per_sample * self.dt
         loop.hub_angle += loop.hub_spin * interval
         row = sample_row(self, phase, interval)
+        row.update(balance_row(self.structure.take_impulses(), self.structure.linear_momentum() - momentum,
+                               self.structure.hub_applied_force, self._slide_damper, self.weight))
         for key, val in row.items():
             rows[key].append(float(val))
         if abs(row["wind_up"]) > s.max_wind_up:
@@ -305,9 +319,7 @@ class Testbed:
 
     def restore_state(self, state: dict) -> None:
         """Continue from a :meth:`state` of a run of the same bed, wheel and rig settings."""
-        rows = state["testbed"]["rows"]
-        if set(rows) != set(SERIES_UNITS):
-            raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
+        rows = checkpoint_rows(state["testbed"]["rows"])
         restore_coupled_state(state, self.scene, self.structure, self.contact, same_spheres=self.patch is None)
         if self.patch is not None:
             self.patch.restore_state(state["patch"])
@@ -322,6 +334,18 @@ class Testbed:
         weights = np.maximum(self.structure.mass, 0.0)
         weights[self.structure.hub_nodes] += self.wheel.hub_mass / max(len(self.structure.hub_nodes), 1)
         return deformation(nodes, self.mesh.nodes, weights)
+
+
+def checkpoint_rows(rows: dict) -> dict:
+    """A checkpoint's series as this testbed records them (:data:`~.run_summary.SERIES_UNITS`): a checkpoint taken
+    before the force balance was recorded (:data:`~.force_balance.BALANCE_UNITS`) has those columns NaN for its
+    samples; any other difference is refused."""
+    rows = {k: np.asarray(v, float) for k, v in rows.items()}
+    if set(rows) - set(SERIES_UNITS) or set(SERIES_UNITS) - set(rows) - set(BALANCE_UNITS):
+        raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
+    for k in set(BALANCE_UNITS) - set(rows):
+        rows[k] = np.full(len(rows["t"]), np.nan)
+    return rows
 
 
 def _bed_and_plan(bed: Bed | str | Path, wheel: WheelGeometry | None, spec: TestbedSpec | None,

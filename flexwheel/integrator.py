@@ -40,7 +40,7 @@ def node_update(
     w: ti.template(), mass: ti.template(), inertia: ti.template(), free: ti.template(), f_ext: ti.template(),
     k_ext: ti.template(), x_anchor: ti.template(), m_ext: ti.template(), slot_start: ti.template(),
     slot_list: ti.template(), slot_f: ti.template(), slot_m: ti.template(), f_tot: ti.template(),
-    m_tot: ti.template(), hub: ti.template(),
+    m_tot: ti.template(), hub: ti.template(), j_ext: ti.template(), j_damp: ti.template(),
 ):
     """Gather node n's force and moment from its element slots; advance it if it is free.
 
@@ -52,10 +52,16 @@ def node_update(
     evaluated with the node at ``x_anchor`` together with their stiffness k_ext [N/m], so that within
     the sub-steps the force follows the node's own motion (otherwise a light node under stiff contacts
     would be driven unstably by forces held over the whole coupling interval).
+
+    The node's momentum account (the force balance's record, :meth:`.structure.Structure.balance`): ``j_ext``
+    gathers the impulse dt (f_ext - k_ext (x - x_anchor)) [N s] the external (contact) force gives, ``j_damp`` that
+    of the damping. The update below is m (v' - v) = dt f - d dt m ((v + v') / 2 - v_rigid) exactly (c1 = 1 - h,
+    c2 = 1 / (1 + h), h = d dt / 2), so the damping's impulse is the last term, taken from the two velocities.
     """
     c1 = 1.0 - 0.5 * damping * dt
     c2 = 1.0 / (1.0 + 0.5 * damping * dt)
     f = f_ext[n] + mass[n] * gravity - k_ext[n] * (x[n] - x_anchor[n])
+    j_ext[n] += dt * (f_ext[n] - k_ext[n] * (x[n] - x_anchor[n]))
     m = m_ext[n]
     for k in range(slot_start[n], slot_start[n + 1]):
         s = slot_list[k]
@@ -66,7 +72,9 @@ def node_update(
     if free[n]:
         spin = hub[HUB_SPIN]
         v_rigid = hub[HUB_VELOCITY] + spin.cross(x[n] - hub[HUB_POSITION])
+        v_before = v[n]
         v[n] = v_rigid + (c1 * (v[n] - v_rigid) + (dt / mass[n]) * f) * c2
+        j_damp[n] -= (damping * dt * mass[n]) * (0.5 * (v_before + v[n]) - v_rigid)
         x[n] += dt * v[n]
         w[n] = spin + (c1 * (w[n] - spin) + (dt / inertia[n]) * m) * c2
         rot[n] = exp_so3(dt * w[n]) @ rot[n]

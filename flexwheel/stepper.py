@@ -39,7 +39,8 @@ class StructureArrays:
     slot_f, slot_m (the corners' forces and moments). Facets: tri, frame0, local0, km, kb (corners, reference
     frame and local coordinates, membrane and bending stiffness, packed: :func:`.shell.pack_stiffness`). Beams:
     ends, bframe0, blen0, rigidity. Hub: hub_nodes, hub_offset, hub (its rows, :data:`.integrator.HUB_ROWS`),
-    hub_rot, hub_scalar. peak: kinetic damping's last energy.
+    hub_rot, hub_scalar. peak: kinetic damping's last energy. j_ext, j_damp: each node's impulse [N s] from its
+    external (contact) force and from the damping since they were last zeroed (the force balance's record).
     """
 
     x: ti.Ndarray
@@ -74,6 +75,8 @@ class StructureArrays:
     hub_rot: ti.Ndarray
     hub_scalar: ti.Ndarray
     peak: ti.Ndarray
+    j_ext: ti.Ndarray
+    j_damp: ti.Ndarray
 
     @cached_property
     def kernel_args(self) -> tuple:
@@ -111,6 +114,7 @@ def _steps_serial(
     tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d, kb: nd_f64_2d,
     ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
     hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
+    j_ext: nd_vec3, j_damp: nd_vec3,
 ):
     """``n_steps`` complete steps in one launch, every loop serial."""
     gravity = vec3(gx, gy, gz)
@@ -122,7 +126,7 @@ def _steps_serial(
             beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets, 1)
         for n in range(n_nodes):
             itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
-                            m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
+                            m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp)
         if n_hub > 0:
             itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
             for k in range(n_hub):
@@ -159,6 +163,7 @@ def steps_parallel(n_steps: int, beams: bool = True) -> GraphKernel:
         tri: nd_ivec3, frame0: nd_mat3, local0: nd_mat32, km: nd_f64_2d, kb: nd_f64_2d,
         ends: nd_ivec2, bframe0: nd_mat3, blen0: nd_f64, rigidity: nd_vec4,
         hub_nodes: nd_i32, hub_offset: nd_vec3, hub: nd_vec3, hub_rot: nd_mat3, hub_scalar: nd_f64, peak: nd_f64,
+        j_ext: nd_vec3, j_damp: nd_vec3,
     ):
         gravity = vec3(gx, gy, gz)
         for _step in ti.static(range(n_steps)):
@@ -174,7 +179,7 @@ def steps_parallel(n_steps: int, beams: bool = True) -> GraphKernel:
                                      3 * n_facets, 1)
             for n in range(n_nodes):
                 itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
-                                m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub)
+                                m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp)
             ti.loop_config(serialize=True)
             for _ in range(1):
                 if n_hub > 0:

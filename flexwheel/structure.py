@@ -11,6 +11,7 @@ surface.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import taichi as ti
@@ -28,6 +29,19 @@ from .shell import shell_energies, shell_forces
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
+
+
+@dataclass(frozen=True)
+class MomentumAccount:
+    """What changed a structure's linear momentum over ``duration`` [s] (:meth:`Structure.take_impulses`), each an
+    impulse [N s] (3-vector): ``contact``, the external (contact) forces as the sub-steps applied them; ``damping``,
+    the structural damping; ``reaction``, the reactions of the hub's prescribed dofs. The rig's applied force and
+    gravity, constant over an interval, are the caller's to add."""
+
+    contact: np.ndarray
+    damping: np.ndarray
+    reaction: np.ndarray
+    duration: float
 
 
 class Structure:
@@ -125,6 +139,7 @@ class Structure:
             self.critical_time_step = 2.0 / omega * (math.sqrt(1.0 + zeta**2) - zeta)
         self.time = 0.0
         self.steps_taken = 0
+        self._account_time = 0.0  # the time the impulse accounts span (take_impulses)
         self.serial = (self.rigid or mesh.n_elements <= self.SERIAL_ELEMENT_LIMIT) if serial is None else bool(serial)
 
     # ------------------------------------------------------------------ time stepping
@@ -177,6 +192,7 @@ class Structure:
                     dt, self.damping, *g, int(kinetic_damping), *counts, *arrays)
         self.time += dt * n_steps
         self.steps_taken += n_steps
+        self._account_time += dt * n_steps
 
     def advance(self, interval: float, forces=None, moments=None, *, check: bool = True) -> int:
         """Advance by ``interval`` seconds in equal sub-steps no larger than the stable step.
@@ -291,6 +307,11 @@ class Structure:
         return self._hub_state()[itg.HUB_SPIN].copy()
 
     @property
+    def hub_applied_force(self) -> np.ndarray:
+        """The force the rig applies to the hub [N] (``drive_hub(force=...)``), held until changed."""
+        return self._hub_state()[itg.HUB_APPLIED_FORCE].copy()
+
+    @property
     def hub_rotation(self) -> np.ndarray:
         self._hub_state()
         return self.arrays.hub_rot.to_numpy()[0]
@@ -309,6 +330,46 @@ class Structure:
             self.arrays.hub.from_numpy(s)
             self.arrays.hub_scalar.from_numpy(scal)
         return f, m
+
+    def linear_momentum(self) -> np.ndarray:
+        """The structure's linear momentum [kg m/s] as its integrator carries it: each free node's m v, and the hub's
+        whole mass (its own and its nodes') times its velocity."""
+        a = self.arrays
+        mass, v, free = a.mass.to_numpy(), a.v.to_numpy(), a.free.to_numpy().astype(bool)
+        p = (mass[free, None] * v[free]).sum(axis=0)
+        if self.hub_nodes.size:
+            hub_mass = a.hub_scalar.to_numpy()[itg.HUB_OWN_MASS] + mass[self.hub_nodes].sum()
+            p = p + hub_mass * self._hub_state()[itg.HUB_VELOCITY]
+        return p
+
+    def gravity_force(self) -> np.ndarray:
+        """The weight of the whole structure [N]: every node's mass and the hub's own, times gravity."""
+        total = self.arrays.mass.to_numpy().sum()
+        if self.hub_nodes.size:
+            total += self.arrays.hub_scalar.to_numpy()[itg.HUB_OWN_MASS]
+        return total * np.asarray(self.gravity, float)
+
+    def take_impulses(self) -> MomentumAccount:
+        """What changed the structure's momentum since the last call (or its construction), and zero the accounts:
+        the impulses [N s] of the external (contact) forces as the sub-steps applied them, of the damping, and of the
+        hub's held dofs' reactions, with the time they span [s] (:class:`MomentumAccount`). With the rig's applied
+        force and gravity, they add up to the change of :meth:`linear_momentum` (the internal forces cancel)."""
+        a = self.arrays
+        contact = a.j_ext.to_numpy().sum(axis=0)
+        damping = a.j_damp.to_numpy().sum(axis=0)
+        a.j_ext.fill(0.0)
+        a.j_damp.fill(0.0)
+        reaction = np.zeros(3)
+        if self.hub_nodes.size:
+            s = self._hub_state()
+            scal = a.hub_scalar.to_numpy()
+            steps = scal[itg.HUB_SAMPLES]
+            # the reaction's sum over the steps times their (equal) length
+            reaction = s[itg.HUB_REACTION_FORCE] * (self._account_time / steps if steps > 0 else 0.0)
+            self.hub_reaction(reset=True)
+        account = MomentumAccount(contact=contact, damping=damping, reaction=reaction, duration=self._account_time)
+        self._account_time = 0.0
+        return account
 
     # ------------------------------------------------------------------ state out
     def device_arrays(self) -> stepper.StructureArrays:

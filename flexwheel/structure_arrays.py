@@ -57,14 +57,15 @@ def slot_arrays(mesh: StructureMesh) -> dict:
 
 def node_arrays(mesh: StructureMesh, mass: np.ndarray, inertia: np.ndarray, tied: np.ndarray) -> dict:
     """The nodes' state at rest in the mesh's positions, their lumped mass and inertia (1 where a node tied to the
-    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants."""
+    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants, the impulse accounts (zero)."""
     n = mesh.n_nodes
     zeros = np.zeros((n, 3))
     return {"x": _vec(mesh.nodes), "v": _vec(zeros), "rot": _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3))),
             "w": _vec(zeros), "mass": _nd(ti.f64, np.where(mass > 0, mass, 1.0)),
             "inertia": _nd(ti.f64, np.where(inertia > 0, inertia, 1.0)), "free": _nd(ti.i32, (~tied).astype(np.int32)),
             "f_ext": _vec(zeros), "k_ext": _nd(ti.f64, np.zeros(n)), "x_anchor": _vec(mesh.nodes), "m_ext": _vec(zeros),
-            "f_tot": _vec(zeros), "m_tot": _vec(zeros), "peak": _nd(ti.f64, np.zeros(2))}
+            "f_tot": _vec(zeros), "m_tot": _vec(zeros), "peak": _nd(ti.f64, np.zeros(2)), "j_ext": _vec(zeros),
+            "j_damp": _vec(zeros)}
 
 
 def hub_arrays(mesh: StructureMesh, hub: np.ndarray, center: np.ndarray, hub_mass: float, hub_inertia) -> dict:

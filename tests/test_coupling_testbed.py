@@ -58,6 +58,24 @@ def test_steady_state_force_balance_and_signs(steering_run):
     assert result.info["fe_substeps"] >= result.info["dem_steps"]
 
 
+def test_the_vertical_force_balance_closes_to_round_off_at_every_sample(steering_run):
+    """Issue 35 item 1: the flexible wheel's momentum changes by the impulses the record holds (the soil's force as
+    the sub-steps applied it, the rig's load, the slide's damper and reaction, the structural damping, the weight),
+    at every sample of every phase -- lowered at a held speed, released, spun up, driven -- to round-off; the summary
+    gives the residual's mean, and the force the wheel integrated beside the one the contact reported."""
+    bench, result = steering_run
+    s, w, weight = result.series, MINI_RUN.load, bench.wheel_mass * bench.gravity
+    assert np.abs(s["balance_residual"]).max() < 1e-9 * w
+    lowering = s["slide_reaction"] != 0.0  # the slide held while the wheel is lowered: its reaction is recorded
+    assert lowering[0] and not lowering[-1]
+    assert np.allclose(s["rig_load"][~lowering], -(w - weight), rtol=1e-12)  # W - m g down once released
+    assert np.allclose(s["weight"], -weight, rtol=1e-12)
+    assert np.any(s["structural_damping"] != 0.0)  # a flexible wheel's damping has a resultant
+    assert abs(result.summary.balance_residual.mean) < 1e-9 * w
+    # the soil's force as the wheel integrated it is the reported one to within a fraction of a per cent here
+    assert result.summary.vertical_force_applied.mean == pytest.approx(result.summary.vertical_force.mean, rel=0.01)
+
+
 def test_no_particle_inside_the_wheel(steering_run):
     bench, result = steering_run
     surface = ContactSurface.from_mesh(bench.mesh)
@@ -93,6 +111,9 @@ def test_rigid_wheel_tread_turns_with_the_hub(mini_bed):
     assert np.abs(result.series["wind_up"]).max() < 1e-9
     assert np.allclose(result.series["tread_slip"][drive], 0.3, atol=1e-6)
     assert np.allclose(result.series["tread_slip_angle"][drive], 10.0, atol=1e-6)
+    # its force balance closes too, with no structural damping
+    assert np.abs(result.series["balance_residual"]).max() < 1e-9 * MINI_RUN.load
+    assert np.all(result.series["structural_damping"] == 0.0)
 
 
 @pytest.mark.slow  # three 30 s runs
