@@ -11,8 +11,9 @@ deep box's packing (``density/plate``) against the deep box and the lab's box, a
 10 % of the deep box everywhere and more than 10 % from the lab box somewhere, the density explains the depth doubling;
 within 10 % of the lab box everywhere, the depth does; otherwise both.
 
-The depth doubling at equal packing (``docs/soillab/box/depth.sh``, fixed before its runs): the deep box poured looser,
-to the lab box's packing (``depth/plate``), against the lab's box by the box check's rule (a change below 10 % of the
+The depth doubling at equal packing (``docs/soillab/box/depth.sh`` for the lab's box, ``depth-wide.sh`` for the wide
+one, each fixed before its runs): the deep box poured looser, to the shallow box's packing (``depth/plate``,
+``depth-wide/plate``), against the shallow box by the box check's rule (a change below 10 % of the
 deeper box's pressure at every sinkage: the lab box's depth holds the plate at equal packing); beside it, the two
 packings and the looser deep box against the deep box (the density's effect at equal depth).
 
@@ -33,6 +34,10 @@ ALLOWED = 0.10
 DOUBLINGS = (("across", "lab", "wide"), ("in depth", "lab", "deep"),
              ("across", "wide", "wider"), ("in depth", "wide", "wide-deep"))
 PLATE = 0.1
+#: The depth doublings at equal packing: (key in check.json, the box, its deep box poured loose, the folder of the deep
+#: box poured to the box's packing, the script that ran it), folder names under ``--boxes``.
+EQUAL_PACKING = (("depth_at_equal_packing", "lab", "deep", "depth", "depth.sh"),
+                 ("wide_depth_at_equal_packing", "wide", "wide-deep", "depth-wide", "depth-wide.sh"))
 
 
 def pressures(folder: Path) -> dict | None:
@@ -111,23 +116,26 @@ def main(argv=None) -> int:
         cell = "–" if density[key] is None else " / ".join(f"{c:+.0%}" for c in density[key])
         lines.append(f"| {name} | {cell} |")
     lines += ["", f"Verdict: {density['verdict']}."]
-    equal = depth_at_equal_packing(pressures(boxes / "lab"), pressures(boxes / "deep"),
-                                   pressures(boxes / "depth" / "plate"))
-    equal["packing"] = {name: packing(boxes / folder) for name, folder in
-                        (("lab", "lab"), ("deep", "deep"), ("looser_deep", "depth/plate"))}
-    pk = equal["packing"]
     fmt = (lambda v: "–" if v is None else f"{v:.4f}")
-    lines += ["", "Depth at equal packing (`depth.sh`: the deep box poured looser, to the lab box's packing; packing "
-              f"lab {fmt(pk['lab'])}, deep {fmt(pk['deep'])}, looser deep {fmt(pk['looser_deep'])}):", "",
-              "| looser deep box against | change at 10 / 15 / 20 mm |", "|---|---|"]
-    for key, name in (("changes", "the lab's box (the depth doubling at equal packing)"),
-                      ("from_deep", "the deep box (the density at equal depth)")):
-        cell = "–" if equal[key] is None else " / ".join(f"{c:+.0%}" for c in equal[key])
-        lines.append(f"| {name} | {cell} |")
-    lines += ["", f"Verdict on the depth doubling at equal packing: {equal['verdict']}."]
+    equals = {}
+    for key, box, deep, looser, script in EQUAL_PACKING:
+        equal = depth_at_equal_packing(pressures(boxes / box), pressures(boxes / deep),
+                                       pressures(boxes / looser / "plate"))
+        equal["packing"] = {name: packing(boxes / folder) for name, folder in
+                            (("box", box), ("deep", deep), ("looser_deep", f"{looser}/plate"))}
+        pk = equal["packing"]
+        lines += ["", f"Depth at equal packing, the {box} box (`{script}`: its deep box poured looser, to its packing; "
+                  f"packing {box} {fmt(pk['box'])}, deep {fmt(pk['deep'])}, looser deep {fmt(pk['looser_deep'])}):",
+                  "", "| looser deep box against | change at 10 / 15 / 20 mm |", "|---|---|"]
+        for k, name in (("changes", f"the {box} box (the depth doubling at equal packing)"),
+                        ("from_deep", "its deep box poured loose (the density at equal depth)")):
+            cell = "–" if equal[k] is None else " / ".join(f"{c:+.0%}" for c in equal[k])
+            lines.append(f"| {name} | {cell} |")
+        lines += ["", f"Verdict on the {box} box's depth doubling at equal packing: {equal['verdict']}."]
+        equals[key] = equal
     (boxes / "check.md").write_text("\n".join(lines) + "\n")
     (boxes / "check.json").write_text(json.dumps({"doublings": verdicts, "depth_or_density": density,
-                                                  "depth_at_equal_packing": equal}, indent=1) + "\n")
+                                                  **equals}, indent=1) + "\n")
     print("\n".join(lines))
     return 0
 

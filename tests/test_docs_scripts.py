@@ -249,5 +249,6 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     equal = json.loads((tmp_path / "check.json").read_text())["depth_at_equal_packing"]
     assert equal["verdict"] == "passes" and equal["changes"] == pytest.approx([0.08] * 3)
     assert equal["from_deep"] == pytest.approx([(1 / 0.92 - 1.25) * 0.92] * 3)
-    assert equal["packing"] == {"lab": 0.52, "deep": 0.52, "looser_deep": 0.515}
-    assert "Verdict on the depth doubling at equal packing: passes." in (tmp_path / "check.md").read_text()
+    assert equal["packing"] == {"box": 0.52, "deep": 0.52, "looser_deep": 0.515}
+    assert "Verdict on the lab box's depth doubling at equal packing: passes." in (tmp_path / "check.md").read_text()
+    assert json.loads((tmp_path / "check.json").read_text())["wide_depth_at_equal_packing"]["verdict"] == "not run yet"
