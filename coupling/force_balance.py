@@ -12,8 +12,12 @@ linearised force f - k (x - x_a), which differs from the force the contact evalu
 free slide (-(W - m g) once released), D the slide's damper (-c v_z), R the held slide's reaction (while the wheel is
 lowered at a prescribed speed), S the structural damping's resultant and G the weight -m g. The residual of that sum
 against the momentum's rate is round-off when every force the integrator applied is in the record: a residual above
-round-off is a force the record misses. Averaged over a steady window, dP_z / dt is about zero and
-F_applied = W + (the damper, the damping and the residual's means), which is how a load the soil does not carry shows.
+round-off is a force the record misses. Since L + G = -W once released, over a steady window
+
+    F_applied = W + dP_z/dt - D - S,
+
+so a soil force short of the load W is read off as the slide's damper holding part of it (a wheel still sinking),
+the structural damping's resultant, or a wheel still accelerating.
 """
 
 from __future__ import annotations

@@ -53,7 +53,7 @@ def node_update(
     the sub-steps the force follows the node's own motion (otherwise a light node under stiff contacts
     would be driven unstably by forces held over the whole coupling interval).
 
-    The node's momentum account (the force balance's record, :meth:`.structure.Structure.balance`): ``j_ext``
+    The node's momentum account (the force balance's record, :meth:`.structure.Structure.take_impulses`): ``j_ext``
     gathers the impulse dt (f_ext - k_ext (x - x_anchor)) [N s] the external (contact) force gives, ``j_damp`` that
     of the damping. The update below is m (v' - v) = dt f - d dt m ((v + v') / 2 - v_rigid) exactly (c1 = 1 - h,
     c2 = 1 / (1 + h), h = d dt / 2), so the damping's impulse is the last term, taken from the two velocities.

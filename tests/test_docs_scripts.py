@@ -252,3 +252,18 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     assert equal["packing"] == {"box": 0.52, "deep": 0.52, "looser_deep": 0.515}
     assert "Verdict on the lab box's depth doubling at equal packing: passes." in (tmp_path / "check.md").read_text()
     assert json.loads((tmp_path / "check.json").read_text())["wide_depth_at_equal_packing"]["verdict"] == "not run yet"
+
+
+def test_the_force_balance_table_averages_each_term_over_the_steady_window(tmp_path):
+    """docs/force_balance_table.py: every term's mean over the summary's window (samples after its start, to its end)
+    and the largest residual over every sample, read from a result's own files."""
+    from result_files import summary, write_result
+
+    from wheelsoil.cases.schema import load_case
+
+    table = _load("force_balance_table")
+    # the stand-in series run 0, 0.25, ..., 1 s in every column; a window (0.25, 0.75] holds the samples at 0.5, 0.75
+    write_result(tmp_path / "run", load_case("mini-1g-steer"), [summary(0.3, window=(0.25, 0.75))])
+    row = table.balance(tmp_path / "run")
+    assert row["vertical_force_applied"] == pytest.approx(0.625) and row["weight"] == pytest.approx(0.625)
+    assert row["largest_residual"] == 1.0 and row["steady"] and row["load"] == 80.0
