@@ -300,6 +300,23 @@ def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
     return (wheel.radius + soil.grouser_tip_fraction * wheel.grouser_height) * soil.radius_scale
 
 
+def contact_points(theta_f, theta_m, theta_r):
+    """The contact's quadrature points (C conditions, Q points): theta [rad] and the weights on [theta_m, theta_f]
+    and [theta_r, theta_m], their sines and cosines (taken once: every integral of :func:`contact_forces` needs them),
+    and the cosine of the angle the normal stress is evaluated at: theta itself ahead of theta_m, and behind it the
+    angle mapped linearly onto [theta_m, theta_f] (Wong & Reece's rear region, seed 003 eq. 7)."""
+    x, w = gauss_legendre()
+    th_front, w_front = gauss_on(theta_m, theta_f, x, w)
+    th_rear, w_rear = gauss_on(theta_r, theta_m, x, w)
+    span = np.where(theta_m - theta_r > 0.0, theta_m - theta_r, 1.0)[:, None]
+    equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
+    theta = np.concatenate([th_front, th_rear], axis=1)
+    weight = np.concatenate([w_front, w_rear], axis=1)
+    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
+    cos_stress = np.concatenate([cos_theta[:, :th_front.shape[1]], np.cos(equivalent)], axis=1)
+    return theta, weight, sin_theta, cos_theta, cos_stress
+
+
 def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity,
                    extra_pressure=0.0, passes=1.0, vertical_only: bool = False, travel_slip=None, load=np.nan) -> dict:
     """Soil forces on the wheel at a given sinkage (arrays broadcast together; ``slip_angle`` in degrees).
@@ -344,16 +361,7 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     shear_modulus = drifted("shear_modulus_x")  # k_y = k_x when k_x drifts (tied, as calibrated)
     shear_modulus_y = shear_modulus if soil.drift_field == "shear_modulus_x" else soil.shear_modulus_y
 
-    x, w = gauss_legendre()
-    th_front, w_front = gauss_on(theta_m, theta_f, x, w)
-    th_rear, w_rear = gauss_on(theta_r, theta_m, x, w)
-    span = np.where(theta_m - theta_r > 0.0, theta_m - theta_r, 1.0)[:, None]
-    equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
-    theta = np.concatenate([th_front, th_rear], axis=1)
-    weight = np.concatenate([w_front, w_rear], axis=1)
-    # each point's sine and cosine once (every integral below takes them); the stress angle is theta ahead of theta_m
-    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
-    cos_stress = np.concatenate([cos_theta[:, :th_front.shape[1]], np.cos(equivalent)], axis=1)
+    theta, weight, sin_theta, cos_theta, cos_stress = contact_points(theta_f, theta_m, theta_r)
     sigma = k_pressure[:, None] * np.clip(cos_stress - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
     sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
