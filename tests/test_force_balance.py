@@ -41,3 +41,16 @@ def test_a_checkpoint_from_before_the_balance_continues_with_its_columns_unknown
     assert np.array_equal(rows["drawbar_pull"], np.arange(3.0))
     with pytest.raises(WheelsoilInputError, match="do not match"):
         checkpoint_rows({**old, "something_else": np.zeros(3)})
+
+
+def test_the_run_summary_prints_the_balance_where_it_was_recorded():
+    """``wheelsoil run``'s summary lines give the soil's force as the wheel integrated it and the residual; a result
+    from before the balance was recorded prints no such line."""
+    from result_files import summary
+
+    from wheelsoil.cases.commands.run import summary_lines
+
+    recorded = summary(0.3, vertical_force_applied=(497.4, 6.2), balance_residual=(-4.5e-13, 4e-14))
+    line = [s for s in summary_lines(recorded) if "force balance" in s]
+    assert len(line) == 1 and "497.4 N" in line[0] and "-4.5e-13 N" in line[0]
+    assert not any("force balance" in s for s in summary_lines(summary(0.3)))
