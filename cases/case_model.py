@@ -98,8 +98,8 @@ class Soil(_Section):
     max_settle_time: float = _q(smoke.SOIL["max_settle_time"], "s", "give up preparing the bed after this much "
                                 "settling", _BED["max_settle_time"])
     pour_friction_factor: float = _q(1.0, "1", "sliding and rolling friction are multiplied by this while the bed is "
-                                     "poured: 1 a loose pour, 0 frictionless spheres, the densest bed, above 1 looser; the run uses "
-                                     "the friction above", _BED["pour_friction_factor"])
+                                     "poured: 1 a loose pour, 0 frictionless spheres, the densest bed, above 1 "
+                                     "looser; the run uses the friction above", _BED["pour_friction_factor"])
     rolling_model: Literal["cdt", "epsd"] = Field(
         "cdt", description="the rolling-resistance law of every soil contact (soil--soil, bin walls, wheel): 'cdt' "
                            "constant directional torque, or 'epsd' elastic--plastic spring--dashpot, which holds a "

@@ -342,7 +342,8 @@ def checkpoint_rows(rows: dict) -> dict:
     samples; any other difference is refused."""
     rows = {k: np.asarray(v, float) for k, v in rows.items()}
     if set(rows) - set(SERIES_UNITS) or set(SERIES_UNITS) - set(rows) - set(BALANCE_UNITS):
-        raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's {sorted(SERIES_UNITS)}")
+        raise WheelsoilInputError(f"checkpoint series {sorted(rows)} do not match this testbed's "
+                                  f"{sorted(SERIES_UNITS)}")
     for k in set(BALANCE_UNITS) - set(rows):
         rows[k] = np.full(len(rows["t"]), np.nan)
     return rows

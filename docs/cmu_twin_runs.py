@@ -41,8 +41,8 @@ QUANTITIES = {"drawbar_pull": ("drawbar_pull", "drawbar pull", 1.0, "N"),
 #: (22-26 N) reaches 12-15 mm from first contact (``force_displacement/wheel_sinkage.csv``). The twin's tread sinkage is
 #: the rim's lowest point below the levelled surface; a grousered wheel first touches with its 5 mm grouser tips, so
 #: the references may differ by up to the grouser height, and a difference within that is not resolved.
-SINKAGE_REFERENCE = ("The trials' sinkage is the lab's (its scripts add the 31.5 mm they take as the wheel's sinkage at "
-                     "its start to the carriage's travel; the free-rolling trials at 0° give 14–16 mm where the static "
+SINKAGE_REFERENCE = ("The trials' sinkage is the lab's (its scripts add the 31.5 mm they take as the wheel's sinkage "
+                     "at its start to the carriage's travel; the free-rolling trials at 0° give 14–16 mm where the static "
                      "press of the same wheels at their loads reaches 12–15 mm, so it reads as sinkage below the "
                      "surface, as the lab's model fit uses it); the twin's tread sinkage is the rim's lowest point "
                      "below the levelled surface. The grousered wheel first touches with its 5 mm grouser tips, so a "

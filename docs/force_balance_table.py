@@ -58,7 +58,8 @@ def main(argv=None) -> int:
         lines.append(
             f"| {r['run']} | {'rigid' if r['rigid'] else 'flexible'}, {r['gravity']}, {r['load']:g} N | "
             f"{'steady' if r['steady'] else 'not steady'} {r['window'][0]:.2f}–{r['window'][1]:.2f} s | "
-            f"{r['vertical_force']:.2f} | {r['vertical_force_applied']:.2f} (± {r['vertical_force_applied_ci95']:.1f}) | "
+            f"{r['vertical_force']:.2f} | {r['vertical_force_applied']:.2f} "
+            f"(± {r['vertical_force_applied_ci95']:.1f}) | "
             f"{r['rig_load']:.2f} | {r['slide_damper']:+.2f} | {r['slide_reaction']:+.2f} | "
             f"{r['structural_damping']:+.2f} | {r['weight']:.2f} | {r['momentum_rate']:+.3f} | "
             f"{r['largest_residual']:.1e} |")

@@ -57,7 +57,8 @@ def slot_arrays(mesh: StructureMesh) -> dict:
 
 def node_arrays(mesh: StructureMesh, mass: np.ndarray, inertia: np.ndarray, tied: np.ndarray) -> dict:
     """The nodes' state at rest in the mesh's positions, their lumped mass and inertia (1 where a node tied to the
-    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants, the impulse accounts (zero)."""
+    hub has none), ``free`` (not ``tied``), the held loads, the contact's stiffness and anchors, the resultants, the
+    impulse accounts (zero)."""
     n = mesh.n_nodes
     zeros = np.zeros((n, 3))
     return {"x": _vec(mesh.nodes), "v": _vec(zeros), "rot": _nd(mat3, np.broadcast_to(np.eye(3), (n, 3, 3))),

@@ -6,8 +6,8 @@ Protocol (as a lab prepares a soil bin, and as seed 004 section 2.3 prepares its
    above the bin floor, enough for ``overfill`` times the target depth at packing fraction 0.6.
 2. *Settle* under the gravity the bed will be tested at (with the sliding and rolling friction of every pair
    multiplied by ``pour_friction_factor``: 1, the default, is a loose pour; below 1 the spheres slide into a
-   denser packing, above 1 they lock into a looser one, the DEM's usual way to set a sample's density, e.g. Salot, Gotteland & Villard 2009,
-   Granular Matter 11:221), until the kinetic energy per particle
+   denser packing, above 1 they lock into a looser one, the DEM's usual way to set a sample's density, e.g.
+   Salot, Gotteland & Villard 2009, Granular Matter 11:221), until the kinetic energy per particle
    falls below a threshold (default: that of the mean particle moving at 5 mm/s).
 3. *Level*: remove every sphere whose centre lies above the target height, then settle again.
 4. *Measure*: surface height (mean over d_max-wide columns of the highest sphere top) and the bulk

@@ -94,7 +94,8 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
     lines = table.markdown(records)
     assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
     # the sinkage beside the trial's as a difference in mm (the trials give one value each, no std)
-    assert f" / {1e3 * data.responses['sinkage'][k]:.1f} / {1e3 * (0.03 - data.responses['sinkage'][k]):+.1f} mm | " in lines[2]
+    trial_sinkage = 1e3 * data.responses["sinkage"][k]
+    assert f" / {trial_sinkage:.1f} / {30.0 - trial_sinkage:+.1f} mm | " in lines[2]
     assert "**no**" in lines[3]
     assert " / +2.0 | " in lines[4] and ", +0.900, " in lines[5]
     assert all(np.isnan(r["drum_fill"]) and not r["side_walls"] for r in records)  # stand-ins keep no frame

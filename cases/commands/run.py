@@ -82,8 +82,9 @@ def summary_lines(s: RunSummary) -> list[str]:
                  f"tread slip angle {s.tread_slip_angle.mean:.2f} deg, commanded "
                  f"{s.commanded_slip_angle:g}; wind-up {s.wind_up.mean:.3f} rad)")
     if math.isfinite(s.balance_residual.mean):  # recorded since 2026-11-28 (coupling.force_balance)
-        lines.append(f"  {'force balance':16s} soil force as the wheel integrated it {s.vertical_force_applied.mean:.4g} N; "
-                     f"residual of the wheel's momentum {s.balance_residual.mean:.1e} N")
+        lines.append(f"  {'force balance':16s} soil force as the wheel integrated it "
+                     f"{s.vertical_force_applied.mean:.4g} N; residual of the wheel's momentum "
+                     f"{s.balance_residual.mean:.1e} N")
     if s.steady:
         lines.append("  (the intervals see the noise within this run; runs on other seeds scatter more: drawbar pull "
                      "and torque about twice as much in the smoke case. 'wheelsoil replicate' measures it: "
