@@ -61,6 +61,8 @@ def node_update(
     c1 = 1.0 - 0.5 * damping * dt
     c2 = 1.0 / (1.0 + 0.5 * damping * dt)
     f = f_ext[n] + mass[n] * gravity - k_ext[n] * (x[n] - x_anchor[n])
+    # written out again, not shared through a local: the compiler then forms f as before (bit for bit; a shared
+    # product changed how it fused the multiply-add, and the run's trajectory with it)
     j_ext[n] += dt * (f_ext[n] - k_ext[n] * (x[n] - x_anchor[n]))
     m = m_ext[n]
     for k in range(slot_start[n], slot_start[n + 1]):

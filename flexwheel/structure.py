@@ -140,6 +140,11 @@ class Structure:
         self.time = 0.0
         self.steps_taken = 0
         self._account_time = 0.0  # the time the impulse accounts span (take_impulses)
+        # the masses the integrator moves [kg] (set once: the device's node masses, the free nodes, the hub's whole
+        # mass), for linear_momentum and gravity_force
+        self._node_mass = self.arrays.mass.to_numpy()
+        self._free = self.arrays.free.to_numpy().astype(bool)
+        self._hub_mass = float(hub_mass + self._node_mass[hub].sum()) if hub.size else 0.0
         self.serial = (self.rigid or mesh.n_elements <= self.SERIAL_ELEMENT_LIMIT) if serial is None else bool(serial)
 
     # ------------------------------------------------------------------ time stepping
@@ -334,19 +339,15 @@ class Structure:
     def linear_momentum(self) -> np.ndarray:
         """The structure's linear momentum [kg m/s] as its integrator carries it: each free node's m v, and the hub's
         whole mass (its own and its nodes') times its velocity."""
-        a = self.arrays
-        mass, v, free = a.mass.to_numpy(), a.v.to_numpy(), a.free.to_numpy().astype(bool)
-        p = (mass[free, None] * v[free]).sum(axis=0)
+        free = self._free
+        p = (self._node_mass[free, None] * self.arrays.v.to_numpy()[free]).sum(axis=0)
         if self.hub_nodes.size:
-            hub_mass = a.hub_scalar.to_numpy()[itg.HUB_OWN_MASS] + mass[self.hub_nodes].sum()
-            p = p + hub_mass * self._hub_state()[itg.HUB_VELOCITY]
+            p = p + self._hub_mass * self._hub_state()[itg.HUB_VELOCITY]
         return p
 
     def gravity_force(self) -> np.ndarray:
         """The weight of the whole structure [N]: every node's mass and the hub's own, times gravity."""
-        total = self.arrays.mass.to_numpy().sum()
-        if self.hub_nodes.size:
-            total += self.arrays.hub_scalar.to_numpy()[itg.HUB_OWN_MASS]
+        total = self._node_mass[self._free].sum() + self._hub_mass
         return total * np.asarray(self.gravity, float)
 
     def take_impulses(self) -> MomentumAccount:
@@ -359,14 +360,8 @@ class Structure:
         damping = a.j_damp.to_numpy().sum(axis=0)
         a.j_ext.fill(0.0)
         a.j_damp.fill(0.0)
-        reaction = np.zeros(3)
-        if self.hub_nodes.size:
-            s = self._hub_state()
-            scal = a.hub_scalar.to_numpy()
-            steps = scal[itg.HUB_SAMPLES]
-            # the reaction's sum over the steps times their (equal) length
-            reaction = s[itg.HUB_REACTION_FORCE] * (self._account_time / steps if steps > 0 else 0.0)
-            self.hub_reaction(reset=True)
+        # the reaction's mean over the steps (of equal length) times the time they span
+        reaction = self.hub_reaction(reset=True)[0] * self._account_time if self.hub_nodes.size else np.zeros(3)
         account = MomentumAccount(contact=contact, damping=damping, reaction=reaction, duration=self._account_time)
         self._account_time = 0.0
         return account
