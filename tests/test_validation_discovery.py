@@ -23,8 +23,9 @@ from wheelsoil.validation.synthetic import (
     draw_out_of_catalogue,
     load_gravity_conditions,
     synthetic_measurements,
+    whole_domain_conditions,
 )
-from wheelsoil.validation.terramechanics import DRIFT_FIELDS, DRIFT_MEASURES
+from wheelsoil.validation.terramechanics import DRIFT_FIELDS, DRIFT_MEASURES, SoilParameters, drift_conditions
 
 #: Parameters the data fix directly, with the absolute tolerance of their recovery. The scale-type
 #: parameters (sidewall, grouser) and the gravity exponent of cohesion trade against cohesion and friction
@@ -199,7 +200,22 @@ def test_generic_rivals_are_drifts_no_mechanism_states():
         assert {c for _, c in rivals} == set(varied), name
         assert not set(rivals) & CATALOGUE_DRIFTS, name
     assert ("friction_angle", "load") in drift_rivals(EXTENSIONS["gravity_cohesion"], varied)
+    # braking rows: the signed slip is a condition of its own, and a rival of theta_m_slip on cohesion, not on a1
+    whole = synthetic_measurements({}, np.random.default_rng(4), cond=whole_domain_conditions())
+    assert set(varied_conditions(whole)) == set(varied) | {"signed_slip"}
+    rivals = drift_rivals(EXTENSIONS["theta_m_slip"], varied_conditions(whole))
+    assert ("cohesion", "signed_slip") in rivals and ("a1", "signed_slip") not in rivals
     assert drift_reference(data, "load") == float(np.median(data.load)) and drift_reference(data, "slip") == 1.0
+
+
+def test_a_signed_slip_drift_grows_on_driving_rows_and_falls_on_braking_ones():
+    """p (1 + rate i) in the signed slip i, against |i|: the two agree on a driving row and differ on a braking one."""
+    soil = SoilParameters(cohesion=100.0)
+    rows = drift_conditions(np.array([-0.5, 0.0, 0.5]), 0.0, 9.81, 1, 90.0, 0.1, 0.1)
+    signed = replace(soil, drift_field="cohesion", drift_condition="signed_slip", drift_rate=-0.4)
+    absolute = replace(signed, drift_condition="slip")
+    np.testing.assert_allclose(signed.drifted("cohesion", rows), [120.0, 100.0, 80.0])
+    np.testing.assert_allclose(absolute.drifted("cohesion", rows), [80.0, 100.0, 80.0])
 
 
 def test_mechanisms_the_data_cannot_show_are_not_tried():

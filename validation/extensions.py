@@ -127,7 +127,8 @@ EXTENSIONS = {
             "theta_m_slip", "angle of maximum normal stress moving forward with slip",
             "seed 003 eq. 8 (Oida; Wong--Reece): theta_m = (a1 + a2 i) theta_f",
             (Parameter("a2", -0.3, 0.6, sign=1),), {"a2": 0.0},
-            lambda d: _varies(d.slip), ("slip",), (("a1", "slip"),),
+            # linear in the signed slip: a1 drifting with it is this mechanism, not a rival
+            lambda d: _varies(d.slip), ("slip", "signed_slip"), (("a1", "slip"), ("a1", "signed_slip")),
         ),
         Extension(
             "soil_flow", "soil under the rim carried along with it, reducing the shear displacement",
@@ -220,11 +221,18 @@ def drift_rival(field: str, condition: str) -> Extension:
 
 def varied_conditions(data) -> tuple[str, ...]:
     """The conditions of :data:`~.terramechanics.DRIFT_MEASURES` whose measure varies over ``data``'s rows (a drift
-    along a constant condition is the classical parameter again)."""
+    along a constant condition is the classical parameter again), each once: a condition whose measure equals an
+    earlier one's on every row (the signed slip on rows that all drive is |slip|) is left out, its drift being the
+    same fit."""
     rows = drift_conditions(*(np.asarray(v, float) for v in (data.slip, np.radians(data.slip_angle), data.gravity,
                                                               data.passes, data.load, data.radius, data.width)))
-    return tuple(c for c, measure in DRIFT_MEASURES.items()
-                 if np.ptp(measure({**rows, "reference": drift_reference(data, c)})) > 0.0)
+    kept, measures = [], []
+    for c, measure in DRIFT_MEASURES.items():
+        u = np.broadcast_to(measure({**rows, "reference": drift_reference(data, c)}), np.shape(rows["slip"]))
+        if np.ptp(u) > 0.0 and not any(np.array_equal(u, m) for m in measures):
+            kept.append(c)
+            measures.append(u)
+    return tuple(kept)
 
 
 def drift_reference(data, condition: str) -> float:

@@ -61,7 +61,8 @@ OUT_OF_CATALOGUE = {
         "field": "shear_modulus_x", "range": (0.8, 1.5),
         "law": lambda v, m, c: v * (c["load"] / 90.0) ** m},
     "cohesion_slip_softening": {
-        "description": "cohesion lost as the soil is sheared, c (1 - s i) (strain softening)",
+        "description": "cohesion lost as the soil is sheared, c (1 - s i) (strain softening; linear in the signed "
+                       "slip, so braking rows, i < 0, are harder)",
         "field": "cohesion", "range": (0.7, 0.95),
         "law": lambda v, s, c: v * (1.0 - s * c["slip"])},
     "friction_steering": {

@@ -74,7 +74,10 @@ SHEAR_FORMS = ("independent", "resultant")
 #: stresses (normal stress, shear strength and displacement, theta_m); the sidewall, bulldozing and grouser terms
 #: keep the soil's own value.
 DRIFT_FIELDS = ("cohesion", "friction_angle", "shear_modulus_x", "kc_prime", "kphi_prime", "n0", "a1")
-#: The measure u of each condition a drift is linear in, u = 0 at the reference state: |slip|, sin|slip angle|,
+#: The measure u of each condition a drift is linear in, u = 0 at the reference state: |slip| and the signed slip
+#: (a drift that grows on driving rows and falls on braking ones; added 2026-11-28, docs/validation/campaigns.md says
+#: why; on rows of one sign it is |slip| again and the workflow fits it once, :func:`~.extensions.varied_conditions`),
+#: sin|slip angle|,
 #: the fall in gravity 1 - g / 9.81, the earlier passes n_p - 1, and for the load and the wheel's radius and width,
 #: conditions of scale, the log ratio ln(x / x_ref) to the reference ``SoilParameters.drift_reference`` (the discovery
 #: workflow takes the training rows' median): p (1 + rate ln(x / x_ref)) is a power law p (x / x_ref)^rate to first
@@ -83,6 +86,7 @@ DRIFT_FIELDS = ("cohesion", "friction_angle", "shear_modulus_x", "kc_prime", "kp
 #: (:func:`drift_conditions`).
 DRIFT_MEASURES = {
     "slip": lambda c: np.abs(c["slip"]),
+    "signed_slip": lambda c: np.asarray(c["slip"], float),
     "slip_angle": lambda c: np.abs(np.sin(c["beta"])),
     "gravity": lambda c: 1.0 - c["gravity"] / EARTH_GRAVITY,
     "passes": lambda c: c["passes"] - 1.0,
