@@ -61,3 +61,21 @@ def test_a_cross_validation_resumes_from_its_finished_folds(tmp_path, monkeypatc
     calls.clear()
     run(2)
     assert len(calls) == 4  # another seed matches no saved fold
+    calls.clear()
+    monkeypatch.setattr(crossval, "rule_digest", lambda: "another rule")
+    run(2)
+    assert len(calls) == 4  # folds saved under another selection rule are computed again
+
+
+def test_the_rule_digest_follows_the_rivals_and_margins(monkeypatch):
+    """The selection rule's digest changes with a margin and with the conditions the rivals drift along."""
+    from wheelsoil.validation import selection, terramechanics
+
+    before = selection.rule_digest()
+    assert selection.rule_digest() == before
+    monkeypatch.setattr(selection, "RIVAL_MARGIN", selection.RIVAL_MARGIN + 1.0)
+    assert selection.rule_digest() != before
+    monkeypatch.undo()
+    fewer = {k: v for k, v in terramechanics.DRIFT_MEASURES.items() if k != "signed_slip"}
+    monkeypatch.setattr(selection, "DRIFT_MEASURES", fewer)
+    assert selection.rule_digest() != before

@@ -7,7 +7,8 @@ conditions it was fitted on, and the mechanisms found per fold whether the findi
 
 Each fold is independent (its bootstrap draws from its own seed, (seed, fold index)), so a cross-validation
 resumes: with ``resume_dir`` every finished fold is written there as it ends and kept by a later run of the same
-data, responses, seed and starting soil (``wheelsoil validate --cv ... --resume``).
+data, selection rule (:func:`~.selection.rule_digest`), responses, seed and starting soil (``wheelsoil validate --cv
+... --resume``); a fold saved under another rule is computed again.
 """
 
 import hashlib
@@ -22,6 +23,7 @@ from wheelsoil.provenance import atomic_output, provenance, write_markdown_and_j
 from .calibration import normalised_residuals
 from .discovery import discover
 from .measured import Measurements
+from .selection import rule_digest
 
 CV_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height", "group")
 
@@ -50,9 +52,11 @@ def _data_digest(data: Measurements) -> str:
 
 
 def _fold_key(digest: str, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
-    """What a saved fold must match to be kept: the data (:func:`_data_digest`), the held-out level, the responses,
-    the seed, the bootstrap size and the starting soil."""
-    return {"data": digest, "condition": by, "level": level if isinstance(level, str) else float(level),
+    """What a saved fold must match to be kept: the data (:func:`_data_digest`), the selection rule
+    (:func:`~.selection.rule_digest`), the held-out level, the responses, the seed, the bootstrap size and the
+    starting soil."""
+    return {"data": digest, "rule": rule_digest(), "condition": by,
+            "level": level if isinstance(level, str) else float(level),
             "responses": list(responses), "seed": seed, "bootstrap": bootstrap,
             "start": None if start is None else start.to_dict()}
 

@@ -4,10 +4,14 @@ workflow found (:class:`Discovery`), with the margins a candidate must pass to b
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import hashlib
+import json
+from dataclasses import asdict, dataclass, field
 
+from . import residuals
 from .calibration import Fit
-from .extensions import Extension
+from .extensions import BASELINE_FREE, BASELINE_OFF, DRIFT_RATE, EXTENSIONS, Extension
+from .terramechanics import DRIFT_FIELDS, DRIFT_FLOOR, DRIFT_MEASURES, RELATIVE_DRIFTS
 
 BIC_MARGIN = 10.0
 #: The held-out check guards against a fit that predicts worse than the model it extends; the evidence is BIC's.
@@ -30,6 +34,25 @@ RIVAL_MARGIN = 2.0
 MIN_EXPLAINED = 0.5
 #: A mechanism "moves" a response when its effect's RMS there is at least this share of the response's spread.
 MOVES_RESPONSE = 0.05
+
+
+def rule_digest() -> str:
+    """A digest of the selection rule as declared: the margins above, the calibrated parameters and their bounds, the
+    catalogue (each mechanism's parameters, off values, the conditions it acts through and the drifts it states),
+    the generic rivals' fields, conditions and rate range, and the residual tests' thresholds. A saved result made
+    under another rule does not match (a resumed cross-validation recomputes its folds, :mod:`.crossval`). The
+    equations themselves are not in it: a change to a formula changes results without changing the digest."""
+    rule = {
+        "margins": [BIC_MARGIN, GAIN_SIGMAS, PAIR_POOL, AMBIGUITY_MARGIN, RIVAL_MARGIN, MIN_EXPLAINED, MOVES_RESPONSE],
+        "free": [asdict(p) for p in BASELINE_FREE], "off": BASELINE_OFF,
+        "catalogue": {n: {"parameters": [asdict(p) for p in e.parameters], "off": e.off,
+                          "acts_through": list(e.acts_through), "drifts": sorted(map(list, e.drifts))}
+                      for n, e in sorted(EXTENSIONS.items())},
+        "drifts": {"fields": list(DRIFT_FIELDS), "conditions": list(DRIFT_MEASURES), "relative": list(RELATIVE_DRIFTS),
+                   "rate": asdict(DRIFT_RATE), "floor": DRIFT_FLOOR},
+        "residuals": [list(residuals.CONDITIONS), residuals.LACK_OF_FIT_ALPHA, residuals.NAMED_SHARE],
+    }
+    return hashlib.sha256(json.dumps(rule, sort_keys=True, default=float).encode()).hexdigest()[:16]
 
 
 @dataclass
