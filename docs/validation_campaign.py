@@ -60,6 +60,7 @@ def draw(kind: str, index: int, seed_seq, design: str = "factorial") -> dict:
     """One synthetic dataset of ``kind`` in ``design`` (:data:`DESIGNS`) and the workflow's verdict on it."""
     from wheelsoil.validation import synthetic as syn
     from wheelsoil.validation.discovery import discover
+    from wheelsoil.validation.selection import rule_digest
 
     rng = np.random.default_rng(seed_seq)
     names = list(syn.HIDDEN_RANGES)
@@ -78,7 +79,7 @@ def draw(kind: str, index: int, seed_seq, design: str = "factorial") -> dict:
     t0 = time.perf_counter()
     d = discover(data, seed=int(rng.integers(2 ** 31)))
     found = d.found
-    return {"kind": kind, "design": design, "index": index, "truth": truth, "hidden": hidden, "effect": effect, "noise": noise,
+    return {"kind": kind, "design": design, "rule": rule_digest(), "index": index, "truth": truth, "hidden": hidden, "effect": effect, "noise": noise,
             "relative_noise": relative, "found": found, "partial": [c.extension.name for c in d.partial],
             "ambiguities": d.ambiguities,
             "unexplained": [u["text"] for u in d.unexplained], "wrong": sorted(set(found) - set(truth)),
@@ -90,6 +91,8 @@ def draw(kind: str, index: int, seed_seq, design: str = "factorial") -> dict:
 def _run(args) -> int:
     from concurrent.futures import ProcessPoolExecutor
 
+    from wheelsoil.validation.selection import rule_digest
+
     out = Path(args.out or f"docs/validation/campaigns/{args.kind}-{args.seed}.jsonl")
     out.parent.mkdir(parents=True, exist_ok=True)
     seqs = np.random.SeedSequence(args.seed).spawn(args.draws)
@@ -100,6 +103,14 @@ def _run(args) -> int:
         if other:
             raise SystemExit(f"{out} holds draws of design {sorted(other)}, not --design {args.design}: resume it with "
                              f"that design, or write to another --out")
+        rules = {r["rule"] for r in kept if "rule" in r} - {rule_digest()}
+        if rules:
+            raise SystemExit(f"{out} holds draws made under another selection rule ({sorted(rules)}, now "
+                             f"{rule_digest()}): a campaign measures one rule; write to another --out")
+        unstamped = sum("rule" not in r for r in kept)
+        if unstamped:
+            print(f"{out}: {unstamped} draw(s) made before the rule was recorded with each draw, kept as this rule's",
+                  flush=True)
         done = {r["index"] for r in kept}
         print(f"{out}: {len(done)} draw(s) done before, kept", flush=True)
     with open(out, "a" if args.resume else "w") as fh, ProcessPoolExecutor(args.workers) as pool:
