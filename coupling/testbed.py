@@ -269,7 +269,7 @@ class Testbed:
         if phase != "lower" and self.axle_damping > 0.0:
             self._apply_load(float(self.structure.hub_velocity[2]))
         momentum = self.structure.linear_momentum()
-        self.structure.take_impulses()  # the force balance's accounts start with the interval
+        self.structure.reset_impulses()  # the force balance's accounts start with the interval
         self.scene.step(self.steps_per_sample)
         if self.patch is not None:
             self.patch.drop_thrown_out(self.scene)

@@ -358,13 +358,19 @@ class Structure:
         a = self.arrays
         contact = a.j_ext.to_numpy().sum(axis=0)
         damping = a.j_damp.to_numpy().sum(axis=0)
-        a.j_ext.fill(0.0)
-        a.j_damp.fill(0.0)
         # the reaction's mean over the steps (of equal length) times the time they span
-        reaction = self.hub_reaction(reset=True)[0] * self._account_time if self.hub_nodes.size else np.zeros(3)
+        reaction = self.hub_reaction(reset=False)[0] * self._account_time if self.hub_nodes.size else np.zeros(3)
         account = MomentumAccount(contact=contact, damping=damping, reaction=reaction, duration=self._account_time)
-        self._account_time = 0.0
+        self.reset_impulses()
         return account
+
+    def reset_impulses(self) -> None:
+        """Zero the impulse accounts (:meth:`take_impulses`) without reading them: an interval's record starts here."""
+        self.arrays.j_ext.fill(0.0)
+        self.arrays.j_damp.fill(0.0)
+        if self.hub_nodes.size:
+            self.hub_reaction(reset=True)
+        self._account_time = 0.0
 
     # ------------------------------------------------------------------ state out
     def device_arrays(self) -> stepper.StructureArrays:
