@@ -17,6 +17,11 @@ one, each fixed before its runs): the deep box poured looser, to the shallow box
 deeper box's pressure at every sinkage: the lab box's depth holds the plate at equal packing); beside it, the two
 packings and the looser deep box against the deep box (the density's effect at equal depth).
 
+The wide box's seeds (``docs/soillab/box/wide-seeds.sh``, fixed before its runs): the wide box pressed with seeds 1 and
+2 (``wide-seed1``, ``wide-seed2``) beside seed 0 (``wide``); both of its doublings (across, ``wider``, and in depth at
+equal packing, ``depth-wide/plate``) judged again by the same rule against the three seeds' mean pressure, the
+doubled boxes one seed each; the seeds' pressures, packings and spread beside.
+
 Usage (from the repository root; seconds)::
 
     python docs/soillab_box_check.py --boxes docs/soillab/box
@@ -85,6 +90,34 @@ def depth_at_equal_packing(lab: dict | None, deep: dict | None, loose_deep: dict
                  else [(loose_deep[z] - deep[z]) / loose_deep[z] for z in SINKAGES])
     return {**doubling, "from_deep": from_deep}
 
+#: The wide box's seeds (folder names under ``--boxes``) and the doublings judged against their mean:
+#: (what is doubled, the doubled box's folder).
+WIDE_SEEDS = ("wide", "wide-seed1", "wide-seed2")
+WIDE_DOUBLINGS = (("across", "wider"), ("in depth at equal packing", "depth-wide/plate"))
+
+
+def seed_mean(curves: list[dict | None]) -> dict | None:
+    """The mean pressure [Pa] over seeds at :data:`SINKAGES` (None until every seed has run)."""
+    if any(c is None for c in curves):
+        return None
+    return {z: sum(c[z] for c in curves) / len(curves) for z in SINKAGES}
+
+
+def wide_three_seeds(boxes: Path) -> dict:
+    """The wide box's seeds and both of its doublings judged against their mean (module docstring)."""
+    curves = [pressures(boxes / s) for s in WIDE_SEEDS]
+    mean = seed_mean(curves)
+    seeds = [{"folder": s, "packing": packing(boxes / s),
+              "pressure_Pa": None if c is None else [c[z] for z in SINKAGES]} for s, c in zip(WIDE_SEEDS, curves)]
+    spread = None
+    if mean is not None:
+        n = len(curves)
+        spread = [(sum((c[z] - mean[z]) ** 2 for c in curves) / (n - 1)) ** 0.5 / mean[z] for z in SINKAGES]
+    doublings = [{"doubled": what, "doubled_box": big, **judge(mean, pressures(boxes / big))}
+                 for what, big in WIDE_DOUBLINGS]
+    return {"seeds": seeds, "mean_Pa": None if mean is None else [mean[z] for z in SINKAGES],
+            "relative_spread": spread, "doublings": doublings}
+
 
 def packing(folder: Path) -> float | None:
     """The packing fraction of the bed the plate was pressed in (``folder/plate.json``; None: not run yet)."""
@@ -133,9 +166,21 @@ def main(argv=None) -> int:
             lines.append(f"| {name} | {cell} |")
         lines += ["", f"Verdict on the {box} box's depth doubling at equal packing: {equal['verdict']}."]
         equals[key] = equal
+    wide = wide_three_seeds(boxes)
+    kpa = (lambda values: "–" if values is None else " / ".join(f"{1e-3 * v:.1f}" for v in values))
+    lines += ["", "The wide box's seeds (`wide-seeds.sh`: both doublings against the three seeds' mean):", "",
+              "| wide box | packing | pressure at 10 / 15 / 20 mm [kPa] |", "|---|---|---|"]
+    lines += [f"| {s['folder']} | {fmt(s['packing'])} | {kpa(s['pressure_Pa'])} |" for s in wide["seeds"]]
+    spread = ("–" if wide["relative_spread"] is None
+              else " / ".join(f"{c:.0%}" for c in wide["relative_spread"]))
+    lines += [f"| mean (the seeds' standard deviation, of the mean) | | {kpa(wide['mean_Pa'])} ({spread}) |", "",
+              "| doubled | the three-seed wide box → | change at 10 / 15 / 20 mm | verdict |", "|---|---|---|---|"]
+    for d in wide["doublings"]:
+        change = "–" if d["changes"] is None else " / ".join(f"{c:+.0%}" for c in d["changes"])
+        lines.append(f"| {d['doubled']} | {d['doubled_box']} | {change} | {d['verdict']} |")
     (boxes / "check.md").write_text("\n".join(lines) + "\n")
     (boxes / "check.json").write_text(json.dumps({"doublings": verdicts, "depth_or_density": density,
-                                                  **equals}, indent=1) + "\n")
+                                                  **equals, "wide_three_seeds": wide}, indent=1) + "\n")
     print("\n".join(lines))
     return 0
 

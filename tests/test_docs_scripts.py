@@ -253,6 +253,22 @@ def test_the_box_check_reads_its_rule_from_the_runs(tmp_path):
     assert equal["packing"] == {"box": 0.52, "deep": 0.52, "looser_deep": 0.515}
     assert "Verdict on the lab box's depth doubling at equal packing: passes." in (tmp_path / "check.md").read_text()
     assert json.loads((tmp_path / "check.json").read_text())["wide_depth_at_equal_packing"]["verdict"] == "not run yet"
+    # the wide box's seeds: both doublings judged against the three seeds' mean, once every seed has run
+    box("wider", 1.15 / 0.95)  # 15 % above seed 0 (fails against it)
+    (tmp_path / "depth-wide").mkdir()
+    box("depth-wide/plate", 1 / 0.95 * 1.02)
+    box("wide-seed1", 1 / 0.95 * 1.2)
+    assert json.loads((tmp_path / "check.json").read_text())["wide_three_seeds"]["mean_Pa"] is None
+    check.main(["--boxes", str(tmp_path)])
+    assert json.loads((tmp_path / "check.json").read_text())["wide_three_seeds"]["doublings"][0]["verdict"] == \
+        "not run yet"
+    box("wide-seed2", 1 / 0.95 * 1.25)  # the mean 1.15 times seed 0's: the wider box equal to it, the deep one 11 % below
+    check.main(["--boxes", str(tmp_path)])
+    wide = json.loads((tmp_path / "check.json").read_text())["wide_three_seeds"]
+    assert wide["mean_Pa"][0] == pytest.approx(1e6 * 0.01 * 1.15 / 0.95)
+    assert wide["relative_spread"] == pytest.approx([np.std([1.0, 1.2, 1.25], ddof=1) / 1.15] * 3)
+    assert [d["verdict"] for d in wide["doublings"]] == ["passes", "fails (13% against 10%)"]
+    assert wide["doublings"][1]["changes"] == pytest.approx([(1.02 - 1.15) / 1.02] * 3)
 
 
 def test_the_force_balance_table_averages_each_term_over_the_steady_window(tmp_path):
