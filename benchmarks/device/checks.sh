@@ -27,8 +27,9 @@ step() {  # step LIMIT_S NAME COMMAND...: run with a limit, log its exit status
 }
 [ -f .device/taichi.tar.xz ] || { log "no .device/taichi.tar.xz: run benchmarks/device/prepare.sh here and carry .device"; exit 2; }
 rm -rf "$SITE" && mkdir -p "$SITE"
-tar -xJf .device/taichi.tar.xz -C "$SITE" || exit 3
-python3 -m pip install -q --no-deps --no-index --target "$SITE" .device/wheels/*.whl || exit 4
+tar -xJf .device/taichi.tar.xz -C "$SITE" || { log "unpacking taichi failed"; exit 3; }
+python3 -m pip install -q --no-deps --no-index --target "$SITE" .device/wheels/*.whl 2>&1 | tee -a "$OUT/checks.log" \
+  || { log "the wheels do not install: .device/ prepared for another Python (PYVER of prepare.sh)?"; exit 4; }
 python3 - "$SITE" <<'PY' || exit 5
 import shutil, sys, tomllib
 site = sys.argv[1]
