@@ -9,6 +9,7 @@ from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
 from wheelsoil.validation.discovery import RIVAL_MARGIN
 from wheelsoil.validation.extensions import CATALOGUE_DRIFTS, DRIFT_FIELDS, EXTENSIONS
 from wheelsoil.validation.workflow import validate
+from wheelsoil.validation.selection import rule_digest
 
 
 @pytest.mark.slow
@@ -32,7 +33,9 @@ def test_cmu_large_steering_angles_sidewall_helps_but_is_not_named(measured_dir,
     assert "found: nothing" in report and "unexplained: error in lateral force" in report
     for png in ("fits.png", "residuals.png", "candidates.png"):
         assert (tmp_path / png).stat().st_size > 0
-    assert json.loads((tmp_path / "findings.json").read_text())["n_heldout"] > 0
+    saved = json.loads((tmp_path / "findings.json").read_text())
+    assert saved["n_heldout"] > 0
+    assert saved["selection_rule"] == rule_digest()  # which rule made the findings
 
 
 @pytest.mark.slow

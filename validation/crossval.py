@@ -105,7 +105,8 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
         if progress:
             progress(folds[-1])
     names = sorted({n for fold in folds for n in fold["found"]})
-    return {"condition": by, "folds": folds, "found_in": {n: sum(n in f["found"] for f in folds) for n in names}}
+    return {"condition": by, "folds": folds, "found_in": {n: sum(n in f["found"] for f in folds) for n in names},
+            "selection_rule": rule_digest()}
 
 
 def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "",

@@ -24,6 +24,7 @@ from .discovery import (
 )
 from .measured import Measurements
 from .residuals import group_table, residuals_by_group
+from .selection import rule_digest
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
 
@@ -188,7 +189,8 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     findings = {"title": title, "data": data.name, "rows": len(data), "notes": data.notes, "command": command,
-                "excluded": excluded, **d.to_dict(), **(extra or {}), "provenance": provenance()}
+                "excluded": excluded, **d.to_dict(), **(extra or {}), "selection_rule": rule_digest(),
+                "provenance": provenance()}
     preds = {"classical": model_responses(d.baseline.soil, data), "final": model_responses(d.final.soil, data)}
     findings["residuals_by_group"] = residuals_by_group(  # (model - measured) / training scale, every row
         {m: {q: (p[q] - data.responses[q]) / d.scales[q] for q in d.responses} for m, p in preds.items()}, data)
