@@ -80,8 +80,8 @@ def draw(kind: str, index: int, seed_seq, design: str = "factorial") -> dict:
     d = discover(data, seed=int(rng.integers(2 ** 31)))
     found = d.found
     return {"kind": kind, "design": design, "rule": rule_digest(), "index": index, "truth": truth, "hidden": hidden,
-            "effect": effect, "noise": noise, "relative_noise": relative, "found": found, "partial": [c.extension.name for c in d.partial],
-            "ambiguities": d.ambiguities,
+            "effect": effect, "noise": noise, "relative_noise": relative, "found": found,
+            "partial": [c.extension.name for c in d.partial], "ambiguities": d.ambiguities,
             "unexplained": [u["text"] for u in d.unexplained], "wrong": sorted(set(found) - set(truth)),
             "missed": sorted(set(truth) - set(found)), "explained_share": d.explained_share(),
             "baseline_unidentified": sorted(d.baseline.unidentified()), "baseline_at_bounds": d.baseline.at_bounds(),
