@@ -29,6 +29,7 @@ Usage (from the repository root; seconds)::
 
 import argparse
 import json
+import statistics
 import sys
 from pathlib import Path
 
@@ -100,7 +101,7 @@ def seed_mean(curves: list[dict | None]) -> dict | None:
     """The mean pressure [Pa] over seeds at :data:`SINKAGES` (None until every seed has run)."""
     if any(c is None for c in curves):
         return None
-    return {z: sum(c[z] for c in curves) / len(curves) for z in SINKAGES}
+    return {z: statistics.fmean(c[z] for c in curves) for z in SINKAGES}
 
 
 def wide_three_seeds(boxes: Path) -> dict:
@@ -109,10 +110,7 @@ def wide_three_seeds(boxes: Path) -> dict:
     mean = seed_mean(curves)
     seeds = [{"folder": s, "packing": packing(boxes / s),
               "pressure_Pa": None if c is None else [c[z] for z in SINKAGES]} for s, c in zip(WIDE_SEEDS, curves)]
-    spread = None
-    if mean is not None:
-        n = len(curves)
-        spread = [(sum((c[z] - mean[z]) ** 2 for c in curves) / (n - 1)) ** 0.5 / mean[z] for z in SINKAGES]
+    spread = None if mean is None else [statistics.stdev(c[z] for c in curves) / mean[z] for z in SINKAGES]
     doublings = [{"doubled": what, "doubled_box": big, **judge(mean, pressures(boxes / big))}
                  for what, big in WIDE_DOUBLINGS]
     return {"seeds": seeds, "mean_Pa": None if mean is None else [mean[z] for z in SINKAGES],

@@ -103,10 +103,11 @@ def _run(args) -> int:
         if other:
             raise SystemExit(f"{out} holds draws of design {sorted(other)}, not --design {args.design}: resume it with "
                              f"that design, or write to another --out")
-        rules = {r["rule"] for r in kept if "rule" in r} - {rule_digest()}
+        rule = rule_digest()
+        rules = {r["rule"] for r in kept if "rule" in r} - {rule}
         if rules:
             raise SystemExit(f"{out} holds draws made under another selection rule ({sorted(rules)}, now "
-                             f"{rule_digest()}): a campaign measures one rule; write to another --out")
+                             f"{rule}): a campaign measures one rule; write to another --out")
         unstamped = sum("rule" not in r for r in kept)
         if unstamped:
             print(f"{out}: {unstamped} draw(s) made before the rule was recorded with each draw, kept as this rule's",

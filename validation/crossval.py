@@ -51,11 +51,11 @@ def _data_digest(data: Measurements) -> str:
     return digest.hexdigest()[:20]
 
 
-def _fold_key(digest: str, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
+def _fold_key(digest: str, rule: str, by: str, level, responses, seed: int, bootstrap: int, start) -> dict:
     """What a saved fold must match to be kept: the data (:func:`_data_digest`), the selection rule
     (:func:`~.selection.rule_digest`), the held-out level, the responses, the seed, the bootstrap size and the
     starting soil."""
-    return {"data": digest, "rule": rule_digest(), "condition": by,
+    return {"data": digest, "rule": rule, "condition": by,
             "level": level if isinstance(level, str) else float(level),
             "responses": list(responses), "seed": seed, "bootstrap": bootstrap,
             "start": None if start is None else start.to_dict()}
@@ -72,11 +72,12 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
     values = np.asarray(getattr(data, by))
     folds = []
     digest = _data_digest(data) if resume_dir is not None else ""
+    rule = rule_digest()
     for k, level in enumerate(levels(data, by)):
         mask = values == level
         saved = None
         if resume_dir is not None:
-            key = _fold_key(digest, by, level, responses, seed, bootstrap, start)
+            key = _fold_key(digest, rule, by, level, responses, seed, bootstrap, start)
             saved = Path(resume_dir) / f"fold-{k}.json"
             if saved.is_file():
                 kept = json.loads(saved.read_text())
@@ -106,7 +107,7 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
             progress(folds[-1])
     names = sorted({n for fold in folds for n in fold["found"]})
     return {"condition": by, "folds": folds, "found_in": {n: sum(n in f["found"] for f in folds) for n in names},
-            "selection_rule": rule_digest()}
+            "selection_rule": rule}
 
 
 def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "",
