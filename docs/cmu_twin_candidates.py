@@ -9,9 +9,10 @@ runs are left out (``load_sweep_summary``). The wheel candidates (``WHEEL_CANDID
 runs had been seen) are judged the same way on the trials at 30 and 75 deg, against the twin's runs of those trials
 (``RUNS/cmu-held-out-angles``). Writes ``OUT/<name>.md`` and ``OUT/<name>.json``.
 
-Usage (from the repository root; seconds)::
+Usage (from the repository root; seconds), on the sweeps' summaries the repository records (``docs/cmu_twin_runs.py``
+keeps them, and the runs recorded on earlier machines, in ``docs/cmu-twin/runs/<sweep>/summary.csv``)::
 
-    python docs/cmu_twin_candidates.py --runs RUNS --out docs/cmu-twin/candidates
+    python docs/cmu_twin_candidates.py --runs docs/cmu-twin/runs --out docs/cmu-twin/candidates
 """
 
 import argparse

@@ -13,7 +13,9 @@ again before each entry (so it can be reordered while a case runs), with entries
   (:func:`link_reference`), so the reference is not run twice.
 
 Finished cases are skipped and a running case resumes from its checkpoint, so the script is restarted with the same
-command after an interruption::
+command after an interruption. A case recorded in the repository (its case hash in ``<recorded>/<sweep>/summary.csv``,
+written by ``docs/cmu_twin_runs.py``) is skipped too, though its files are not under ``RUNS`` (a fresh machine): it is
+not run twice. ::
 
     nohup python docs/cmu_twin_queue.py --runs RUNS --queue docs/cmu-twin/queue.json >> RUNS/cmu_queue.log 2>&1 &
 """
@@ -63,8 +65,21 @@ def run_convergence(runs: Path, out: str, case: str, factor: str, drive: float) 
     return rc
 
 
-def run_sweep_case(runs: Path, name: str, wheel: str, angle: float, slip: float, seed) -> None:
-    """The one case of sweep ``name`` at that wheel, steering angle, slip (within 0.05) and seed."""
+def recorded_cases(recorded: Path, sweep: str) -> set[str]:
+    """The case hashes ``recorded/<sweep>/summary.csv`` holds (the runs recorded in the repository; none: empty)."""
+    import csv
+
+    path = recorded / sweep / "summary.csv"
+    if not path.is_file():
+        return set()
+    with open(path, newline="") as f:
+        return {row["case_hash"] for row in csv.DictReader(f)}
+
+
+def run_sweep_case(runs: Path, name: str, wheel: str, angle: float, slip: float, seed,
+                   recorded: Path | None = None) -> None:
+    """The one case of sweep ``name`` at that wheel, steering angle, slip (within 0.05) and seed; skipped where it has
+    finished under ``runs`` or is recorded under ``recorded`` (:func:`recorded_cases`)."""
     from wheelsoil.cases.sweep import Sweep, load_sweep, run_sweep, write_summary
 
     sweep = load_sweep(name, runs / name)
@@ -79,6 +94,9 @@ def run_sweep_case(runs: Path, name: str, wheel: str, angle: float, slip: float,
         log(f"{name} {case.folder.name} finished before")
         write_summary(sweep)
         return
+    if recorded is not None and case.folder.name in recorded_cases(recorded, name):
+        log(f"{name} {case.folder.name} recorded in {recorded / name} (its files are not here); skipped")
+        return
     log(f"start {name} {case.folder.name} {case.name}")
     t0 = time.time()
     status = run_sweep(Sweep(sweep.name, [case], sweep.out, sweep.swept_keys), workers=1)
@@ -90,6 +108,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", required=True, help="folder of the sweeps' runs (outside the repository)")
     ap.add_argument("--queue", default="docs/cmu-twin/queue.json")
+    ap.add_argument("--recorded", default="docs/cmu-twin/runs",
+                    help="the runs recorded in the repository (docs/cmu_twin_runs.py's --out): their cases are skipped")
     args = ap.parse_args(argv)
     runs, queue = Path(args.runs), Path(args.queue)
     k = 0
@@ -100,7 +120,7 @@ def main(argv=None) -> int:
             if entry[0] == "convergence":
                 run_convergence(runs, *entry[1:])
             else:
-                run_sweep_case(runs, *entry)
+                run_sweep_case(runs, *entry, recorded=Path(args.recorded))
         except Exception:  # one failed case does not stop the queue; its traceback is in the log
             traceback.print_exc()
     log("queue done")

@@ -102,6 +102,57 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
     assert all(line.endswith(" | – | 1 s / 1.00 s |") for line in lines[2:])
 
 
+def test_the_twin_runs_recorded_earlier_are_kept_when_their_files_are_gone(tmp_path):
+    """docs/cmu_twin_runs.py on a fresh runs folder: a run recorded earlier whose files are not there keeps its record
+    (marked) and its summary rows; a run found again replaces its earlier record and rows; a case's stages stay
+    together."""
+    table = _load("cmu_twin_runs")
+    earlier = [{"sweep": "cmu-a", "case_hash": "aa", "slip": 0.5, "x": 1},
+               {"sweep": "cmu-a", "case_hash": "cc", "slip": 0.5, "x": 2}]
+    found = [{"sweep": "cmu-a", "case_hash": "cc", "slip": 0.5, "x": 3},
+             {"sweep": "cmu-b", "case_hash": "bb", "slip": 0.5, "stage": 1, "x": 5},
+             {"sweep": "cmu-b", "case_hash": "bb", "slip": 0.3, "stage": 0, "x": 4}]
+    merged = table.merge_records(found, earlier)
+    assert [(r["case_hash"], r["x"], r.get("recorded")) for r in merged] == [
+        ("aa", 1, "earlier"), ("cc", 3, None), ("bb", 4, None), ("bb", 5, None)]
+
+    old, new = tmp_path / "old.csv", tmp_path / "new.csv"
+    old.write_text("case,case_hash,steady,extra\na,aa,True,7\nc,cc,False,8\nd,dd,True,9\nd,dd,True,10\n")
+    new.write_text("case,case_hash,steady\nc,cc,True\nb,bb,True\n")
+    rows = table.merge_summary(new, old)
+    assert [(r["case_hash"], r["steady"], r["extra"]) for r in rows] == [
+        ("aa", "True", "7"), ("bb", "True", ""), ("cc", "True", ""), ("dd", "True", "9"), ("dd", "True", "10")]
+    assert table.merge_summary(None, old) == table.merge_summary(tmp_path / "absent.csv", old)
+    table.write_summary_rows(tmp_path / "out" / "summary.csv", rows)
+    assert table.merge_summary(tmp_path / "out" / "summary.csv", tmp_path / "absent.csv") == rows
+
+
+def test_the_twin_queue_skips_a_case_recorded_in_the_repository(tmp_path, monkeypatch):
+    """docs/cmu_twin_queue.py does not run again a case whose hash the repository's copy of its sweep's summary holds
+    (its files gone with an earlier machine), and runs the others."""
+    queue = _load("cmu_twin_queue")
+    recorded = tmp_path / "recorded"
+    assert queue.recorded_cases(recorded, "cmu-trials-subset") == set()
+    (recorded / "cmu-trials-subset").mkdir(parents=True)
+    (recorded / "cmu-trials-subset" / "summary.csv").write_text("case,case_hash\na,0123\na,0123\nb,4567\n")
+    assert queue.recorded_cases(recorded, "cmu-trials-subset") == {"0123", "4567"}
+
+    from wheelsoil.cases import sweep as sweeps
+
+    runs, started = tmp_path / "runs", []
+    monkeypatch.setattr(sweeps, "run_sweep", lambda s, workers: started.append(s.cases[0].folder.name) or "done")
+    monkeypatch.setattr(sweeps, "write_summary", lambda s: None)
+    cases = sweeps.load_sweep("cmu-trials-subset", runs / "cmu-trials-subset").cases
+    at = [c for c in cases if c.values.get("wheel.preset") == "cmu-k10-grouser"
+          and float(c.values["test.slip_angle"]) in (45.0, 90.0) and abs(float(c.values["test.slip"]) - 0.5) < 0.05]
+    assert len(at) == 2
+    (recorded / "cmu-trials-subset" / "summary.csv").write_text(f"case,case_hash\na,{at[0].folder.name}\n")
+    for c in at:
+        queue.run_sweep_case(runs, "cmu-trials-subset", "cmu-k10-grouser", float(c.values["test.slip_angle"]), 0.5,
+                             None, recorded=recorded)
+    assert started == [at[1].folder.name]  # the recorded one skipped, the other run
+
+
 def test_the_drum_fill_counts_the_grains_inside_an_open_wheel():
     """docs/cmu_twin_runs.py's drum fill: the grains whose centres lie inside the tread and between the side planes of
     a wheel yawed by the steering angle, their solid volume over the drum's (at 90 deg the axle lies along the bin)."""

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The signed-slip rule's campaigns (docs/validation/campaigns.md, "A drift along the signed slip"), one after another
+# at low priority, each resumable: rerun this script after an interruption and finished draws are kept.
+#   nohup bash docs/validation/campaigns/signed-slip.sh >> /work/runs/signed-slip.out 2>&1 &
+set -u
+cd "$(dirname "$0")/../../.."
+PY=${PYTHON:-.venv/bin/python}
+for spec in "ooc 35 94" "single 44 92" "pair 30 93" "null 50 91"; do
+  set -- $spec
+  nice -n 10 "$PY" docs/validation_campaign.py "$1" --draws "$2" --seed "$3" --design whole-domain --workers 1 \
+    --resume >> "docs/validation/campaigns/$1-$3.log" 2>&1
+done
