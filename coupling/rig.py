@@ -12,6 +12,7 @@ import math
 from dataclasses import asdict, dataclass, replace
 from typing import ClassVar
 
+from wheelsoil.bearing import rectangular_footing
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.flexwheel.geometry import WheelGeometry, check_mesh_memory
 from wheelsoil.granular.bed_spec import BedSpec, check_memory, machine_memory
@@ -298,9 +299,34 @@ def plan_rig(bed: BedSpec, wheel: WheelGeometry, test: TestbedSpec) -> RigPlan:
     return RigPlan(bed, wheel, test, check_fits(bed, wheel, test))
 
 
+#: The soil of :func:`load_bound`: the densest random packing of equal spheres (a poured bed of any size spread is
+#: looser) and the top of the bearing formulas' friction angles (a cohesionless granular bed's peak angle is below
+#: it: the soil lab's beds give 34-42 deg), so that no bed the case can make is stronger.
+BOUND_PACKING, BOUND_FRICTION_ANGLE = 0.64, 49.0
+
+
+def load_bound(bed: BedSpec, wheel: WheelGeometry) -> tuple[float, float, float]:
+    """An upper bound [N] of the vertical load the bed can carry under the wheel while it is lowered, with the
+    footprint's length and depth [m]: the lowering stops a run once the rim is half its radius deep
+    (``coupling.protocol.Lower``), so the bound is Meyerhof's ultimate bearing pressure
+    (:func:`wheelsoil.bearing.rectangular_footing`) at that depth on the footprint there, the wheel's width times the
+    chord of its outer (grouser-tip) circle, for the strongest soil of :data:`BOUND_PACKING` and
+    :data:`BOUND_FRICTION_ANGLE` (no cohesion: the DEM has none) under the bed's gravity. It is generous (for the CMU
+    rig about ten times what the lab's sand carries there), so it refuses only a load no bed of the case could carry,
+    before any work: a load in the wrong unit or another rig's."""
+    sink = 0.5 * wheel.radius
+    outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
+    length = 2.0 * math.sqrt(outer ** 2 - (wheel.radius - sink) ** 2)
+    depth = sink + (outer - wheel.radius)
+    unit_weight = BOUND_PACKING * bed.material.density * abs(float(bed.gravity[2]))
+    pressure = rectangular_footing(wheel.width, length, depth, BOUND_FRICTION_ANGLE, 0.0, unit_weight)
+    return pressure * wheel.width * length, length, depth
+
+
 def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
     """Check, before any bed is prepared, that the bed and the wheel mesh fit the machine's memory, that the
-    time step and the load are ones the contact model can take, that the wheel fits the bin and that the bin
+    time step and the load are ones the contact model can take, that the bed could carry the load at all
+    (:func:`load_bound`), that the wheel fits the bin and that the bin
     (or the moving patch on a periodic bin) holds the drive; returns the hub's start position along the bin
     [m]. The errors name the case keys and values."""
     check_memory(bed)
@@ -330,6 +356,15 @@ def check_fits(bed: BedSpec, wheel: WheelGeometry, spec: TestbedSpec) -> float:
             f"({bed.material.youngs_modulus:.3g} Pa): the particles would overlap by more than about a tenth of "
             f"their radius; lower the load (at most {0.05 * bed.material.youngs_modulus * wheel.width * wheel.radius:.3g} N)"
             " or stiffen the soil (soil.youngs_modulus)")
+    bound, length, depth = load_bound(bed, wheel)
+    if spec.load > bound:
+        raise WheelsoilInputError(
+            f"test.load = {spec.load:.4g} N is more than this bed can carry under wheel {wheel.name!r}: the lowering "
+            f"stops a run once the rim is half its radius deep, and there even the strongest soil of these particles "
+            f"(packing {BOUND_PACKING}, friction angle {BOUND_FRICTION_ANGLE:g} deg, no cohesion, gravity "
+            f"{abs(float(bed.gravity[2])):.3g} m/s^2) carries at most {bound:.4g} N on the footprint "
+            f"({wheel.width:g} m x {length:.3g} m, {depth:.3g} m deep; Meyerhof's bearing capacity); lower the load "
+            "(is it in newtons, for this gravity?) or use a larger wheel")
     beta = math.radians(spec.slip_angle)
     outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
     # footprint across the bin: the width turned by beta plus a contact length of about one radius

@@ -13,7 +13,7 @@ Public API::
     circular_footing                                      Meyerhof's and Terzaghi's ultimate bearing pressure
 """
 
-from .bearing import BearingCapacity, circular_footing
+from wheelsoil.bearing import BearingCapacity, circular_footing
 from .bekker import BekkerSplit, PowerFit, common_exponent, fit_k_at_n, fit_power_law, split_k
 from .measured import LoadCurve, load_plate_curves, load_wheel_curves, mean_curve, plate_area
 from .penetration import PenetrationResult, cmu_wheel, plate_test, wheel_press_test

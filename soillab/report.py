@@ -14,7 +14,7 @@ from wheelsoil.parameters import cmu_k10
 from wheelsoil.plotting import pyplot
 from wheelsoil.provenance import atomic_output, provenance
 
-from .bearing import circular_footing
+from wheelsoil.bearing import circular_footing
 from .bekker import PowerFit, common_exponent, fit_k_at_n, fit_power_law, split_k
 from .measured import LoadCurve, mean_curve
 from .penetration import PenetrationResult

@@ -55,6 +55,47 @@ def test_bad_case_is_refused_without_taichi():
     assert "refused:" in done.stdout and "does not fit the bed width" in done.stdout
 
 
+def test_a_load_no_bed_could_carry_is_refused_before_any_work():
+    """A load beyond the bed's bearing bound (``coupling.rig.load_bound``: 5 kN on the CMU wheel, a smoke rig's load
+    in the wrong unit) is refused by the case check, naming the key, the value and the bound, with Taichi
+    unloaded; the presets' own loads pass (``test_case_is_checked_without_taichi``)."""
+    done = _run("""
+        from wheelsoil.cases import schema
+        from wheelsoil.errors import WheelsoilInputError
+        try:
+            schema.load_case("cmu-grouser", ["test.load=5000"])
+        except WheelsoilInputError as exc:
+            print("refused:", exc)
+        assert "taichi" not in sys.modules
+    """)
+    assert done.returncode == 0, done.stderr
+    assert "refused:" in done.stdout and "test.load = 5000 N is more than this bed can carry" in done.stdout
+    assert "at most 3" in done.stdout  # about 3.6 kN for the grousered wheel
+
+
+def test_the_load_bound_is_above_what_the_measured_sand_carried(measured_dir):
+    """The bound is an upper one: for both CMU wheels it exceeds the largest force the measured sand carried when the
+    same wheels were pressed to the bound's depth (``force_displacement/wheel_sinkage.csv``, every box and repeat,
+    sinkage from first contact), and the CMU trials' loads (22-26 N) lie far below it."""
+    import csv
+    from pathlib import Path
+
+    from wheelsoil.cases import build, schema
+    from wheelsoil.coupling.rig import load_bound
+
+    path = Path(measured_dir) / "cmu_3d_terramechanics" / "force_displacement" / "wheel_sinkage.csv"
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    for preset, wheel in (("cmu-grouser", "grouser"), ("cmu-smooth", "smooth")):
+        bed, geometry, test = build.specs(schema.load_case(preset))
+        bound, _, depth = load_bound(bed, geometry)
+        pressed = [float(r["force_N"]) for r in rows
+                   if r["wheel"] == wheel and r["branch"] == "loading" and float(r["sinkage_mm"]) <= 1e3 * depth]
+        assert len(pressed) > 100, preset
+        assert bound > max(pressed), (preset, bound, max(pressed))
+        assert bound > 100 * test.load, (preset, bound, test.load)
+
+
 def test_engine_names_load_on_first_use():
     from wheelsoil import granular
     from wheelsoil.granular.scene import Scene

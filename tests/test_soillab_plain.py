@@ -81,6 +81,21 @@ def test_surface_footing_on_sand_is_the_self_weight_term():
     assert cap.terzaghi == pytest.approx(0.3 * 1.3e4 * 0.1 * n_gamma_t, rel=1e-12)
 
 
+def test_a_long_rectangle_is_meyerhofs_strip_and_a_square_his_circle():
+    """Meyerhof's rectangle: as L/B grows the shape factors go to 1, leaving the strip's 0.5 gamma B N_gamma on the
+    surface with his tabulated N_gamma (15.67 at 30 deg); at B = L it is his circle of diameter B (the same shape
+    factors), in either order of the sides."""
+    from wheelsoil.bearing import rectangular_footing
+
+    assert rectangular_footing(1.0, 1e9, 0.0, 30.0, 0.0, 1e4) == pytest.approx(0.5 * 1e4 * 1.0 * 15.67, rel=1e-3)
+    for depth in (0.0, 0.03):
+        square = rectangular_footing(0.1, 0.1, depth, 35.0, 200.0, 1.3e4)
+        assert square == pytest.approx(circular_footing(0.1, depth, 35.0, 200.0, 1.3e4).meyerhof, rel=1e-12)
+    assert rectangular_footing(0.05, 0.11, 0.03, 35.0, 0.0, 1e4) == rectangular_footing(0.11, 0.05, 0.03, 35.0, 0.0, 1e4)
+    with pytest.raises(WheelsoilInputError, match="footing sizes"):
+        rectangular_footing(0.0, 0.1, 0.0, 30.0, 0.0, 1e4)
+
+
 def test_bearing_capacity_refuses_angles_outside_its_range():
     with pytest.raises(WheelsoilInputError, match="friction_angle = 5"):
         circular_footing(0.1, 0.0, 5.0, 0.0, 1e4)
