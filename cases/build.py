@@ -22,13 +22,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from wheelsoil.coupling.rig import DriveStage, RigPlan, TestbedSpec, plan_rig, stage_spec
+from wheelsoil.coupling.rig import DriveStage, RigPlan, TestbedSpec, plan_rig
 from wheelsoil.flexwheel.geometry import SpokeRow, WheelGeometry, estimated_elements, preset
 from wheelsoil.granular.bed_spec import BedSpec, estimated_particles
 from wheelsoil.material import Material, PairProperties
 from wheelsoil.parameters import seed004, smoke
 
 from .case_model import CaseFile
+from .cost import longest_simulated_seconds
 
 #: Wheel keys that replace the preset's value when given (None: keep the preset's).
 WHEEL_KEYS = ("element_size", "radius", "width", "tread_thickness", "hub_radius", "spokes_per_row", "spoke_thickness",
@@ -124,11 +125,7 @@ def output_bytes(case: CaseFile, test: TestbedSpec, particles: int, elements: in
     longest run of the rig ``test`` (lowering allowed 2 s, settle, and every stage's spin-up or ramp and whole drive,
     :func:`~wheelsoil.coupling.rig.stage_spec`), plus two checkpoints."""
     o = case.output
-    total = 2.0 + test.settle_time
-    for k in range(test.n_stages):
-        stage = stage_spec(test, k)
-        total += stage.spin_up_time
-        total += stage.drive_time
+    total = longest_simulated_seconds(test)
     frames = 1 + (int(total / max(o.frame_interval, o.sample_interval)) if o.frame_interval > 0 else 0)
     per_frame = particles * 7 * 8 + elements * 6 * 8
     return frames * per_frame + 2 * particles * 30 * 8

@@ -27,7 +27,23 @@ def add_parser(sub) -> None:
                    help="dask.distributed scheduler (e.g. tcp://host:8786) to send the cases to instead; its workers "
                         "need wheelsoil installed and the sweep folder on a shared file system")
     p.add_argument("--list", action="store_true", help="only list the cases and whether they are finished")
+    p.add_argument("--budget", type=float, default=None, metavar="HOURS",
+                   help="wall hours the unfinished cases may take on this machine: refused before any run when even "
+                        "the fast end of their estimate (cases/cost.py) cannot be held, said when the slow end cannot "
+                        "(not with --scheduler: a cluster's speed is not this machine's)")
     p.set_defaults(func=cmd)
+
+
+def sweep_budget(sweep, budget_hours: float | None) -> str:
+    """The wall time of the sweep's unfinished cases on this machine, checked against ``budget_hours``
+    (:func:`wheelsoil.cases.cost.check_budget`: refused here, before any run, when it cannot hold them)."""
+    from ..build import plan
+    from ..cost import check_budget, run_cost
+
+    todo = [c for c in sweep.cases if not c.finished]
+    if not todo:
+        return "every case has finished; nothing to run"
+    return check_budget([run_cost(plan(c.case)) for c in todo], budget_hours, "cases")
 
 
 def cmd(args) -> int:
@@ -42,6 +58,10 @@ def cmd(args) -> int:
             print(f"{c.folder.name}  {'finished' if c.finished else 'to run  '}  {c.name}")
         return common.EXIT_OK
     common.check_workers_and_timeout(args.workers, args.timeout)
+    if args.scheduler is None:
+        console.print(sweep_budget(sweep, args.budget))
+    elif args.budget is not None:
+        raise common.InputError("--budget is for runs on this machine; a --scheduler's workers have their own speed")
     workers = args.workers or os.cpu_count() or 1
     status = run_sweep(sweep, workers=workers, scheduler=args.scheduler, arch=args.arch, progress=console.is_terminal,
                        console=console, timeout=args.timeout)

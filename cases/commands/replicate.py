@@ -22,10 +22,28 @@ def add_parser(sub) -> None:
     p.add_argument("--out", type=Path, default=None, help="replica folder (default wheelsoil-output/replicas/<case>)")
     common.add_pool_options(p, "replica", 1, "replicas run at once (default 1)")
     p.add_argument("--report-only", action="store_true", help="only rewrite the report from the finished replicas")
+    p.add_argument("--budget", type=float, default=None, metavar="HOURS",
+                   help="wall hours the replicas still to run may take: refused before any run when even the fast "
+                        "end of their estimate (cases/cost.py) cannot be held, said when the slow end cannot")
     p.add_argument("--widen-by", type=Path, default=None, metavar="REPLICAS_JSON",
                    help="also check the runs' 95 %% intervals widened to t(n_f - 1) f sem, with f = max(1, inflation) "
                         "as another replica set of n_f runs measured it (its replicas.json)")
     p.set_defaults(func=cmd)
+
+
+def replica_budget(sweep, budget_hours: float | None) -> str:
+    """The wall time the sweep's unfinished replicas will take, checked against ``budget_hours``
+    (:func:`wheelsoil.cases.cost.check_budget`: a budget that cannot hold them is refused here, before any run); the
+    estimate comes from the finished replicas' wall times where there are any."""
+    from ..build import plan
+    from ..cost import check_budget, run_cost
+    from ..results import load_result
+
+    todo = [c for c in sweep.cases if not c.finished]
+    walls = [load_result(c.folder).info.get("wall_seconds") for c in sweep.cases if c.finished]
+    if not todo:
+        return "every replica has finished; nothing to run"
+    return check_budget([run_cost(plan(todo[0].case), finished_walls=walls)] * len(todo), budget_hours, "replicas")
 
 
 def cmd(args) -> int:
@@ -41,6 +59,7 @@ def cmd(args) -> int:
     if args.widen_by is not None:
         ReplicaSpread.read(args.widen_by)  # a bad file is refused before any run
     if not args.report_only:
+        console.print(replica_budget(sweep, args.budget))
         run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
     paths = write_report(sweep, case, args.widen_by)
