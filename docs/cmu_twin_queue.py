@@ -18,6 +18,10 @@ written by ``docs/cmu_twin_runs.py``) is skipped too, though its files are not u
 not run twice. ::
 
     nohup python docs/cmu_twin_queue.py --runs RUNS --queue docs/cmu-twin/queue.json >> RUNS/cmu_queue.log 2>&1 &
+
+Beside another long job on the same cores (the soil lab's calibration), give each one thread
+(``WHEELSOIL_CPU_THREADS=1`` in the environment of both): two runs on two cores then step 1.18-1.26 times faster in all
+than with a thread per core each (``cases/sweep.py``, ``benchmarks/README.md``).
 """
 
 import argparse
