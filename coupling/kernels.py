@@ -304,6 +304,63 @@ def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corn
     x_anchor[node] = xw[node] + anchor_lead * vw[node]
 
 
+@ti.func
+def kept_contact(e: ti.i32, i: ti.i32, p: vec3, ri: ti.f64, n_old: ti.i32, claimed: ti.i32, v: ti.template(), omega: ti.template(), mass: ti.template(), inertia: ti.template(),
+                 cand: ti.template(), code: ti.template(), bary: ti.template(), normal: ti.template(),
+                 overlap: ti.template(), f_wheel: ti.template(), m_wheel: ti.template(), xi_new: ti.template(),
+                 roll_new: ti.template(), stiffness: ti.template(), hist_n: ti.template(), hist_xi: ti.template(),
+                 hist_roll: ti.template(), xw: ti.template(), vw: ti.template(), ww: ti.template(),
+                 inv_mass_w: ti.template(), tri: ti.template(), half_t: ti.template(), e_eff: ti.f64, g_eff: ti.f64,
+                 beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, rolling: ti.i32, dt: ti.f64):
+    """Phase C, kept entry ``e`` of sphere ``i`` (centre p, radius ri): the Hertz--Mindlin law with the history matched
+    by normal (:func:`matched_history`; ``claimed`` the slots taken so far), the reaction and its moment for the
+    wheel's nodes, the normal stiffness and the new history written at ``e``. Returns the force on the sphere, n x its
+    tangential force and the rolling torque (:func:`wheelsoil.granular.contact.hertz_mindlin`'s), and ``claimed`` with
+    this contact's slot."""
+    s = cand[e]
+    n = normal[e]
+    depth = overlap[e]
+    best = matched_history(i, n, ti.cast(code[e] == FACE, ti.i32), n_old, claimed, hist_n)
+    xi = vec3(0.0)
+    roll = vec3(0.0)
+    if best >= 0:
+        claimed |= 1 << best
+        xi = hist_xi[i, best]
+        roll = hist_roll[i, best]
+        if code[e] == FACE and n.dot(hist_n[i, best]) < 0.0:
+            # the contact stays on the side of the shell it began on (no tunnelling)
+            n = -n
+            depth = 2.0 * (ri + half_t[s]) - depth
+    i0 = tri[s, 0]
+    i1 = tri[s, 1]
+    i2 = tri[s, 2]
+    b0 = bary[e, 0]
+    b1 = bary[e, 1]
+    b2 = bary[e, 2]
+    point = b0 * xw[i0] + b1 * xw[i1] + b2 * xw[i2]
+    v_wheel = b0 * vw[i0] + b1 * vw[i1] + b2 * vw[i2]
+    w_wheel = b0 * ww[i0] + b1 * ww[i1] + b2 * ww[i2]
+    # effective mass (eq. 13) with the wheel's apparent mass at the contact point: a force F
+    # at c moves the lumped nodes by b_k F / m_k, so 1/m_c = sum b_k^2 / m_k (tied nodes: 0)
+    inv_mc = b0 * b0 * inv_mass_w[i0] + b1 * b1 * inv_mass_w[i1] + b2 * b2 * inv_mass_w[i2]
+    m_eff = 1.0 / (1.0 / mass[i] + inv_mc)
+    fc, tn, m_roll, xi_out, roll_out = hertz_mindlin(
+        n, depth, v[i] + omega[i].cross(ri * n) - v_wheel, omega[i] - w_wheel,
+        ri, m_eff, inertia[i], e_eff, g_eff, beta, mu_s, mu_r, rolling, xi, roll, dt,
+    )
+    f_wheel[e] = -fc
+    stiffness[e] = 2.0 * e_eff * ti.sqrt(ri * depth)  # S_n = dF_n/d(delta_n)
+    # The moment the wheel must also receive for angular momentum to balance exactly: the
+    # particle's torque about the origin is (p + r n) x F + M_roll, the wheel receives -F at
+    # ``point``; it goes to the facet's nodes as a self-equilibrated set of forces (no nodal
+    # moments: a shell node's small rotary inertia would make them stiff).
+    m_wheel[e] = facet_moment_forces(s, xw, tri, -m_roll - (p + ri * n - point).cross(fc))
+    normal[e] = n
+    xi_new[e] = xi_out
+    roll_new[e] = roll_out
+    return fc, tn, m_roll, claimed
+
+
 @ti.kernel
 def wheel_contacts(
     # particles
@@ -349,49 +406,12 @@ def wheel_contacts(
         n_kept = 0
         for e in range(e0, e1):
             if keep[e]:
-                s = cand[e]
-                n = normal[e]
-                depth = overlap[e]
-                best = matched_history(i, n, ti.cast(code[e] == FACE, ti.i32), n_old, claimed, hist_n)
-                xi = vec3(0.0)
-                roll = vec3(0.0)
-                if best >= 0:
-                    claimed |= 1 << best
-                    xi = hist_xi[i, best]
-                    roll = hist_roll[i, best]
-                    if code[e] == FACE and n.dot(hist_n[i, best]) < 0.0:
-                        # the contact stays on the side of the shell it began on (no tunnelling)
-                        n = -n
-                        depth = 2.0 * (ri + half_t[s]) - depth
-                i0 = tri[s, 0]
-                i1 = tri[s, 1]
-                i2 = tri[s, 2]
-                b0 = bary[e, 0]
-                b1 = bary[e, 1]
-                b2 = bary[e, 2]
-                point = b0 * xw[i0] + b1 * xw[i1] + b2 * xw[i2]
-                v_wheel = b0 * vw[i0] + b1 * vw[i1] + b2 * vw[i2]
-                w_wheel = b0 * ww[i0] + b1 * ww[i1] + b2 * ww[i2]
-                # effective mass (eq. 13) with the wheel's apparent mass at the contact point: a force F
-                # at c moves the lumped nodes by b_k F / m_k, so 1/m_c = sum b_k^2 / m_k (tied nodes: 0)
-                inv_mc = b0 * b0 * inv_mass_w[i0] + b1 * b1 * inv_mass_w[i1] + b2 * b2 * inv_mass_w[i2]
-                m_eff = 1.0 / (1.0 / mass[i] + inv_mc)
-                fc, tn, m_roll, xi_out, roll_out = hertz_mindlin(
-                    n, depth, v[i] + omega[i].cross(ri * n) - v_wheel, omega[i] - w_wheel,
-                    ri, m_eff, inertia[i], e_eff, g_eff, beta, mu_s, mu_r, rolling, xi, roll, dt,
-                )
+                fc, tn, m_roll, claimed = kept_contact(e, i, p, ri, n_old, claimed, v, omega, mass, inertia, cand, code,
+                                                   bary, normal, overlap, f_wheel, m_wheel, xi_new, roll_new,
+                                                   stiffness, hist_n, hist_xi, hist_roll, xw, vw, ww, inv_mass_w, tri,
+                                                   half_t, e_eff, g_eff, beta, mu_s, mu_r, rolling, dt)
                 f_total += fc
                 t_total += ri * tn + m_roll
-                f_wheel[e] = -fc
-                stiffness[e] = 2.0 * e_eff * ti.sqrt(ri * depth)  # S_n = dF_n/d(delta_n)
-                # The moment the wheel must also receive for angular momentum to balance exactly: the
-                # particle's torque about the origin is (p + r n) x F + M_roll, the wheel receives -F at
-                # ``point``; it goes to the facet's nodes as a self-equilibrated set of forces (no nodal
-                # moments: a shell node's small rotary inertia would make them stiff).
-                m_wheel[e] = facet_moment_forces(s, xw, tri, -m_roll - (p + ri * n - point).cross(fc))
-                normal[e] = n
-                xi_new[e] = xi_out
-                roll_new[e] = roll_out
                 n_kept += 1
         n_contacts += n_kept
         # the history of this step's contacts
