@@ -14,7 +14,10 @@ README); it is listed, marked, for information.
 The runs' own files live outside the repository and a fresh machine does not have them, so ``OUT`` is the record: a
 run recorded there earlier whose case folder is not under ``RUNS`` is kept as recorded (its record and its summary
 rows; the record marked ``"recorded": "earlier"``; :func:`merge_records`, :func:`merge_summary`), and a run found
-under ``RUNS`` replaces its earlier record. Nothing recorded is lost when the runs folder is new.
+under ``RUNS`` replaces its earlier record. Nothing recorded is lost when the runs folder is new. Each record also holds
+its stage's whole summary (``summary``: every quantity's mean, std, sem, 95 % interval and degrees of freedom,
+``RunSummary.to_dict``), so that statistics over runs (the replicas' spread against the runs' own errors) can be taken
+from the repository alone.
 
 Writes ``OUT/runs.md`` and ``OUT/runs.json``, and copies each sweep's ``summary.csv`` to ``OUT/<sweep>/summary.csv``,
 so that ``wheelsoil validate ../shared/data/measured/cmu_3d_terramechanics --model OUT/<sweep>`` and
@@ -88,6 +91,7 @@ def finished_runs(runs: Path) -> list[dict]:
                 record["vertical_force"] = s.vertical_force.mean
                 record["side_walls"] = bool(case.wheel.side_walls)
                 record["drum_fill"] = fill
+                record["summary"] = s.to_dict()  # the stage's whole summary (RunSummary.from_dict reads it back)
                 out.append(record)
     return out
 

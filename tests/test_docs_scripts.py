@@ -91,6 +91,10 @@ def test_the_twin_runs_table_pairs_each_run_with_its_trial(tmp_path, measured_di
     assert [(r["case_hash"], r.get("stage")) for r in records] == [("a1", None), ("b2", None), ("c3", 0), ("c3", 1)]
     assert [r["slip"] for r in records[2:]] == [data.travel_slip[k], 0.9]
     assert records[0]["trial"] is not None and records[0]["drawbar_pull"] == {"mean": dp, "ci95": 0.5}
+    from wheelsoil.coupling.run_summary import RunSummary
+
+    kept = RunSummary.from_dict(records[0]["summary"])  # the whole summary comes back from the record
+    assert kept.steady and kept.quantity("drawbar_pull").mean == dp and kept.window == (2.0, 9.0)
     lines = table.markdown(records)
     assert " / +2.0 | " in lines[2] and "yes (2.00–9.00 s)" in lines[2]  # drawbar pull two trial stds high
     # the sinkage beside the trial's as a difference in mm (the trials give one value each, no std)
