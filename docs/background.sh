@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The long campaigns that run in the background across sessions (issues 33, 34, 36), each resumable: this script
+# starts those not running, with the settings they share the machine's two cores under. Run it from the repository
+# root at the start of a session (a fresh machine keeps the repository, not RUNS):
+#   bash docs/background.sh [RUNS]        # RUNS: the runs folder outside the repository (default /work/runs)
+# Each job keeps what it finished (the twin's records in docs/cmu-twin/runs, the calibration's candidates in
+# docs/soillab/calibration-epsd-box/candidates, the campaigns' draws in docs/validation/campaigns/*.jsonl); a job
+# already running is left alone. The twin and the calibration get one Taichi thread each (two runs on two cores step
+# 1.18-1.26 times faster in all than with a thread per core each); the campaigns, pure NumPy, run at nice 10.
+set -u
+cd "$(dirname "$0")/.."
+RUNS=${1:-/work/runs}
+PY=${PYTHON:-.venv/bin/python}
+mkdir -p "$RUNS"
+export HDF5_USE_FILE_LOCKING=FALSE WHEELSOIL_CPU_THREADS=1
+running() { pgrep -f "$1" > /dev/null; }
+start() {  # start NAME PATTERN LOG COMMAND...
+  local name=$1 pattern=$2 log=$3; shift 3
+  if running "$pattern"; then echo "$name: running"; return; fi
+  nohup "$@" >> "$log" 2>&1 &
+  echo "$name: started (log $log)"
+}
+start "CMU twin queue (issue 34)" "cmu_twin_queue.py" "$RUNS/cmu_queue.log" \
+  "$PY" docs/cmu_twin_queue.py --runs "$RUNS" --queue docs/cmu-twin/queue.json
+start "wide-box calibration (issue 33)" "soillab_calibration.py run --design epsd-box" \
+  docs/soillab/calibration-epsd-box-run.log \
+  "$PY" docs/soillab_calibration.py run --design epsd-box --box 0.6 0.6 0.12 \
+  --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface \
+  --out docs/soillab/calibration-epsd-box --resume --cache "$RUNS/lab-cache"
+start "signed-slip campaigns (issue 36)" "validation/campaigns/signed-slip.sh" "$RUNS/signed-slip.out" \
+  bash docs/validation/campaigns/signed-slip.sh
