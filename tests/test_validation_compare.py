@@ -32,6 +32,7 @@ def _cond(**kw):
 
 def test_pairs_follow_the_conditions_and_an_offset_is_measured_exactly(tmp_path):
     measured = synthetic_measurements({}, np.random.default_rng(0), cond=_cond())
+    measured.std.update({q: np.full(len(measured), 0.3) for q in ("torque", "sinkage")})  # as a rig states them
     # the simulation ran every other condition, in reverse order, 7 N too high in drawbar pull
     rows = np.arange(len(measured))[::2][::-1]
     sim = _as_sweep_summary(measured, tmp_path / "sweep", offset=7.0, rows=rows)
@@ -44,9 +45,16 @@ def test_pairs_follow_the_conditions_and_an_offset_is_measured_exactly(tmp_path)
     for q in ("lateral_force", "torque", "sinkage"):
         assert c.responses[q]["rmse"] == pytest.approx(0.0, abs=1e-9)
     assert c.responses["torque"]["within_2sigma"] == 1.0
+    assert c.responses["drawbar_pull"]["within_2sigma"] is None  # no measured std given for it
     # normalised by the spread of every measured row, as the semi-empirical model is, not of the paired half only
     assert c.responses["drawbar_pull"]["spread"] == pytest.approx(np.std(measured.responses["drawbar_pull"]), rel=1e-12)
     assert c.responses["drawbar_pull"]["nbias"] == pytest.approx(7.0 / np.std(measured.responses["drawbar_pull"]))
+    # a response measured without a standard deviation (the CMU trials' sinkage) is not judged within 2 sigma on the
+    # simulation's fluctuation alone: it says so (None, "–" in the report)
+    assert c.responses["sinkage"]["within_2sigma"] == 1.0
+    measured.std["sinkage"] = np.full(len(measured), np.nan)
+    c = compare(measured, sim)
+    assert c.responses["sinkage"]["within_2sigma"] is None and c.responses["torque"]["within_2sigma"] == 1.0
 
 
 def test_a_simulation_missing_a_mechanism_shows_a_systematic_trend(tmp_path):
@@ -187,3 +195,25 @@ def test_at_90_degrees_a_run_pairs_only_with_the_trial_at_its_travel_slip(measur
         assert len(pairs) == 0, f"trial at travel slip {data.travel_slip[other]:.3f} paired with the run at 0.5"
     pairs, _ = match_conditions(data, sim)
     assert k in pairs[:, 0] and np.all(np.abs(data.travel_slip[pairs[:, 0]] - data.travel_slip[k]) <= 0.01)
+
+
+def test_several_sweeps_are_one_model(tmp_path):
+    """``--model A B``: the runs of two sweeps taken together compare as one sweep holding both would (the pairs and
+    every statistic); 'semi-empirical' among sweep folders is refused, naming it."""
+    from wheelsoil.validation.workflow import simulated_runs
+
+    measured = synthetic_measurements({}, np.random.default_rng(4), cond=_cond())
+    rows = np.arange(len(measured))
+    whole = compare(measured, _as_sweep_summary(measured, tmp_path / "all", offset=3.0, rows=rows))
+    _as_sweep_summary(measured, tmp_path / "a", offset=3.0, rows=rows[::2])
+    _as_sweep_summary(measured, tmp_path / "b", offset=3.0, rows=rows[1::2])
+    both = simulated_runs([tmp_path / "a", tmp_path / "b"])
+    assert len(both) == len(measured) and both.name == "a + b"
+    split = compare(measured, both)
+    assert len(split.pairs) == len(whole.pairs)
+    for q, v in whole.responses.items():
+        assert split.responses[q]["bias"] == pytest.approx(v["bias"], abs=1e-12)
+        assert split.responses[q]["rmse"] == pytest.approx(v["rmse"], abs=1e-12)
+    with pytest.raises(WheelsoilInputError, match="'semi-empirical' is a model of its own"):
+        simulated_runs([tmp_path / "a", "semi-empirical"])
+

@@ -128,12 +128,14 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
         # the measured spread over every row of the data, not only the paired ones: a sweep that ran a few trials
         # (one, even) is normalised as the semi-empirical model is
         spread = response_scales(data, [q])[q]
-        sd = np.zeros(ok.sum())
-        for m, col in ((data, 0), (simulated, 1)):
-            if q in m.std:
-                sd = sd + np.nan_to_num(m.std[q][pairs[ok, col]]) ** 2
+        # combined standard deviation, judged only where the measured one is known (the CMU trials give their
+        # sinkage without one: a simulated fluctuation alone is no measure of agreement)
+        measured_sd = data.std[q][pairs[ok, 0]] if q in data.std else np.full(ok.sum(), np.nan)
+        sd = np.nan_to_num(measured_sd) ** 2
+        if q in simulated.std:
+            sd = sd + np.nan_to_num(simulated.std[q][pairs[ok, 1]]) ** 2
         sd = np.sqrt(sd)
-        known = sd > 0
+        known = np.isfinite(measured_sd) & (measured_sd > 0)
         stats[q] = {
             "n": int(ok.sum()), "bias": float(np.mean(res)), "rmse": float(np.sqrt(np.mean(res ** 2))),
             "spread": spread, "nbias": float(np.mean(res) / spread), "nrmse": float(np.sqrt(np.mean(res ** 2)) / spread),

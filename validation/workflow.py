@@ -181,20 +181,38 @@ def predict_command(model_path: str, data_arg: str, *, out: Path, group: str | N
             "rows": len(data)}
 
 
-def validate_against_simulation(data_arg: str, model_arg: str, *, report: Path, responses=None, group: str | None = None,
-                                command: str = "", allow_unpaired: bool = False) -> dict:
-    """``wheelsoil validate DATA --model SWEEP``: the DEM--FEM runs of a sweep as the model, compared with the
-    measured data condition by condition (:mod:`.compare`). A run that twins no measured condition is refused
-    (:func:`.compare.check_every_run_paired`) unless ``allow_unpaired``."""
-    from .compare import check_every_run_paired, compare, write_comparison_report
+def simulated_runs(model_args) -> Measurements:
+    """The DEM--FEM runs of one or more sweep folders (or ``summary.csv`` files) as one dataset, in the order given;
+    the steady runs of each (:func:`.measured.load_sweep_summary`), their notes joined."""
+    from dataclasses import replace
+
+    from .candidate_test import concat_runs
     from .measured import load_sweep_summary
+
+    paths = [model_args] if isinstance(model_args, (str, Path)) else list(model_args)
+    if "semi-empirical" in map(str, paths):
+        raise WheelsoilInputError(f"--model {' '.join(map(str, paths))}: 'semi-empirical' is a model of its own; give "
+                                  "it alone, or only sweep folders")
+    parts = [load_sweep_summary(p) for p in paths]
+    if len(parts) == 1:
+        return parts[0]
+    runs = concat_runs(" + ".join(p.name for p in parts), parts)
+    return replace(runs, notes="; ".join(p.notes.rstrip(".") for p in parts if p.notes))
+
+
+def validate_against_simulation(data_arg: str, model_arg, *, report: Path, responses=None, group: str | None = None,
+                                command: str = "", allow_unpaired: bool = False) -> dict:
+    """``wheelsoil validate DATA --model SWEEP [SWEEP ...]``: the DEM--FEM runs of one or more sweeps as the model
+    (:func:`simulated_runs`), compared with the measured data condition by condition (:mod:`.compare`). A run that
+    twins no measured condition is refused (:func:`.compare.check_every_run_paired`) unless ``allow_unpaired``."""
+    from .compare import check_every_run_paired, compare, write_comparison_report
 
     if data_arg in ("synthetic", "synthetic-periodic"):
         raise WheelsoilInputError(f"--model {model_arg!r} compares simulations with measured data; DATA {data_arg!r} is "
                                   "not measured")
     data = load_measurements(data_arg)
     data = select_group(data, group)
-    simulated = load_sweep_summary(model_arg)
+    simulated = simulated_runs(model_arg)
     if not allow_unpaired:
         check_every_run_paired(data, simulated)
     return write_comparison_report(compare(data, simulated, responses), data, simulated, report, command=command)
@@ -205,8 +223,10 @@ def main_validate(args) -> int:
 
     console = Console()
     command = "wheelsoil " + " ".join(getattr(args, "argv", None) or sys.argv[1:])
-    if getattr(args, "model", "semi-empirical") != "semi-empirical":
-        f = validate_against_simulation(args.data, args.model, report=args.report, responses=args.responses,
+    models = getattr(args, "model", ["semi-empirical"])
+    models = [models] if isinstance(models, (str, Path)) else list(models)
+    if models != ["semi-empirical"]:
+        f = validate_against_simulation(args.data, models, report=args.report, responses=args.responses,
                                         group=args.group, command=command,
                                         allow_unpaired=getattr(args, "allow_unpaired_runs", False))
         console.print(f"{f['pairs']} measured conditions paired with a simulated run ({f['unmatched']} without)")

@@ -32,10 +32,11 @@ def add_parser(sub) -> None:
                                    "mechanism: seed 002's density wave or seed 000's spoke-stiffness radius; the "
                                    "frequency law and the amplitude mechanism are named).")
     p.add_argument("data", help="measured data (folder or CSV), a sweep folder, 'synthetic' or 'synthetic-periodic'")
-    p.add_argument("--model", default="semi-empirical",
+    p.add_argument("--model", nargs="+", default=["semi-empirical"], metavar="MODEL",
                    help="model to hold against the data: 'semi-empirical' (default: the terramechanics model, "
-                        "calibrated, with the candidate mechanisms) or a wheelsoil sweep folder / summary.csv (the "
-                        "DEM-FEM runs, compared with the measured data condition by condition)")
+                        "calibrated, with the candidate mechanisms) or one or more wheelsoil sweep folders / "
+                        "summary.csv files (the DEM-FEM runs, taken together and compared with the measured data "
+                        "condition by condition)")
     p.add_argument("--allow-unpaired-runs", action="store_true",
                    help="with --model: leave out runs that twin no measured condition instead of refusing them")
     p.add_argument("--report", type=Path, default=Path("wheelsoil-output/validation"), help="report folder")
