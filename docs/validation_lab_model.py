@@ -94,15 +94,11 @@ def three_models(data, preds: dict, scales: dict, sweeps) -> tuple[dict, list[st
     """The DEM--FEM twin's steady runs of ``sweeps`` (one folder or several, their runs one after another) paired
     with the measured rows, and the three models' bias and RMS error on those rows (normalised by the responses'
     measured spread), as Markdown lines."""
-    from wheelsoil.validation.candidate_test import concat_runs
     from wheelsoil.validation.compare import compare
-    from wheelsoil.validation.measured import load_sweep_summary
+    from wheelsoil.validation.workflow import simulated_runs
 
     sweeps = [sweeps] if isinstance(sweeps, (str, Path)) else list(sweeps)
-    parts = [load_sweep_summary(s) for s in sweeps]
-    simulated = parts[0] if len(parts) == 1 else concat_runs(" + ".join(str(s) for s in sweeps), parts)
-    if len(parts) > 1:
-        simulated.notes = "; ".join(p.notes for p in parts)
+    simulated = simulated_runs(sweeps)
     sweep = " + ".join(str(s) for s in sweeps)
     paired = compare(data, simulated, RESPONSES)  # the pairs and the twin's share within two combined std
     rows, runs = paired.pairs[:, 0], paired.pairs[:, 1]

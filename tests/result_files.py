@@ -21,11 +21,12 @@ def summary(slip: float, *, steady: bool = True, window: tuple = (1.0, 2.0), sli
                       commanded_slip_angle=slip_angle, **stats)
 
 
-def write_result(folder: Path, case, stages) -> Path:
-    """``folder/result.h5`` of ``case`` whose drive's stages have the summaries ``stages`` (the last is the run's)."""
+def write_result(folder: Path, case, stages, wall_seconds: float = 1.0) -> Path:
+    """``folder/result.h5`` of ``case`` whose drive's stages have the summaries ``stages`` (the last is the run's),
+    run in ``wall_seconds``."""
     writer = ResultWriter(folder / RESULT_NAME, {"case_toml": case_to_toml(case), "case_name": case.name,
                                                  "case_hash": case.case_hash()},
                           {"nodes0": np.zeros((3, 3)), "triangles": np.zeros((1, 3)), "beams": np.zeros((0, 2))})
     series = {k: np.linspace(0.0, 1.0, 5) for k in SERIES_UNITS}
-    return writer.finish(series, SERIES_UNITS, stages[-1], {"wall_seconds": 1.0, "simulated_seconds": 1.0},
+    return writer.finish(series, SERIES_UNITS, stages[-1], {"wall_seconds": wall_seconds, "simulated_seconds": 1.0},
                          tuple(stages))

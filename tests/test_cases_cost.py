@@ -73,3 +73,23 @@ def test_batch_refuses_a_budget_it_cannot_hold_before_any_run(tmp_path, capsys):
     assert main(["batch", "cmu-trials-subset", "--out", str(out), "--budget", "1", "--scheduler", "tcp://x:1"]) \
         == EXIT_INPUT
     assert "--budget is for runs on this machine" in capsys.readouterr().err
+
+
+def test_finished_replicas_set_the_estimate_of_the_rest(tmp_path):
+    """``wheelsoil replicate``'s estimate: the finished replicas' mean wall time for each one still to run."""
+    from result_files import summary, write_result
+
+    from wheelsoil.cases.commands.common import budget_said
+    from wheelsoil.cases.replicas import make_replicas
+
+    sweep = make_replicas(schema.load_case("mini-1g-steer"), [0, 1, 2, 3], tmp_path / "r")
+    for c, wall in zip(sweep.cases[:2], (500.0, 700.0)):
+        write_result(c.folder, c.case, [summary(0.3)], wall_seconds=wall)
+    said = budget_said(sweep, 1.0, "replicas", same_case=True)
+    assert said.startswith("2 replicas to run: 20 min in all, 10 min a run (the mean of 2 finished runs here)"), said
+    with pytest.raises(WheelsoilInputError, match="holds 1 at the most"):
+        budget_said(sweep, 0.25, "replicas", same_case=True)
+    for c in sweep.cases[2:]:
+        write_result(c.folder, c.case, [summary(0.3)])
+    assert budget_said(sweep, 0.25, "replicas", same_case=True) == "all replicas have finished; nothing to run"
+

@@ -34,18 +34,6 @@ def add_parser(sub) -> None:
     p.set_defaults(func=cmd)
 
 
-def sweep_budget(sweep, budget_hours: float | None) -> str:
-    """The wall time of the sweep's unfinished cases on this machine, checked against ``budget_hours``
-    (:func:`wheelsoil.cases.cost.check_budget`: refused here, before any run, when it cannot hold them)."""
-    from ..build import plan
-    from ..cost import check_budget, run_cost
-
-    todo = [c for c in sweep.cases if not c.finished]
-    if not todo:
-        return "every case has finished; nothing to run"
-    return check_budget([run_cost(plan(c.case)) for c in todo], budget_hours, "cases")
-
-
 def cmd(args) -> int:
     import os
 
@@ -59,7 +47,7 @@ def cmd(args) -> int:
         return common.EXIT_OK
     common.check_workers_and_timeout(args.workers, args.timeout)
     if args.scheduler is None:
-        console.print(sweep_budget(sweep, args.budget))
+        console.print(common.budget_said(sweep, args.budget))
     elif args.budget is not None:
         raise common.InputError("--budget is for runs on this machine; a --scheduler's workers have their own speed")
     workers = args.workers or os.cpu_count() or 1

@@ -49,3 +49,24 @@ def progress(console):
 
     return Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                     TimeRemainingColumn(), console=console, transient=True)
+
+
+def budget_said(sweep, budget_hours: float | None, what: str = "cases", *, same_case: bool = False) -> str:
+    """The wall time the sweep's unfinished runs will take on this machine, checked against ``budget_hours``
+    (:func:`wheelsoil.cases.cost.check_budget`: a budget that cannot hold them is refused here, before any run). With
+    ``same_case`` (replicas: one case on other seeds) the finished runs' mean wall time is the estimate where there
+    are any; otherwise each run's size gives its range."""
+    from ..build import plan
+    from ..cost import check_budget, run_cost
+    from ..results import load_result
+
+    todo = [c for c in sweep.cases if not c.finished]
+    if not todo:
+        return f"all {what} have finished; nothing to run"
+    if same_case:
+        walls = [load_result(c.folder).info.get("wall_seconds") for c in sweep.cases if c.finished]
+        costs = [run_cost(plan(todo[0].case), finished_walls=walls)] * len(todo)
+    else:
+        costs = [run_cost(plan(c.case)) for c in todo]
+    return check_budget(costs, budget_hours, what)
+

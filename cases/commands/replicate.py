@@ -31,21 +31,6 @@ def add_parser(sub) -> None:
     p.set_defaults(func=cmd)
 
 
-def replica_budget(sweep, budget_hours: float | None) -> str:
-    """The wall time the sweep's unfinished replicas will take, checked against ``budget_hours``
-    (:func:`wheelsoil.cases.cost.check_budget`: a budget that cannot hold them is refused here, before any run); the
-    estimate comes from the finished replicas' wall times where there are any."""
-    from ..build import plan
-    from ..cost import check_budget, run_cost
-    from ..results import load_result
-
-    todo = [c for c in sweep.cases if not c.finished]
-    walls = [load_result(c.folder).info.get("wall_seconds") for c in sweep.cases if c.finished]
-    if not todo:
-        return "every replica has finished; nothing to run"
-    return check_budget([run_cost(plan(todo[0].case), finished_walls=walls)] * len(todo), budget_hours, "replicas")
-
-
 def cmd(args) -> int:
     from ..replicas import ReplicaSpread, make_replicas, write_report
     from ..schema import load_case
@@ -59,7 +44,7 @@ def cmd(args) -> int:
     if args.widen_by is not None:
         ReplicaSpread.read(args.widen_by)  # a bad file is refused before any run
     if not args.report_only:
-        console.print(replica_budget(sweep, args.budget))
+        console.print(common.budget_said(sweep, args.budget, "replicas", same_case=True))
         run_sweep(sweep, workers=args.workers, arch=args.arch, timeout=args.timeout, progress=console.is_terminal,
                   console=console)
     paths = write_report(sweep, case, args.widen_by)
