@@ -218,7 +218,17 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
             over = level_overrides(base, factor, scale, reference_time_step,
                                    common if factor == "particle_size" else None)
             lv = Level(factor, scale, over or {})
-            if over is not None:
+            if over is None:
+                # the level waits for the reference's DEM step; everything else about it (its bed against the
+                # machine's memory, the wheel against the bin) is checked now, so that no level the machine cannot
+                # hold is found out only after the reference has run
+                provisional = level_overrides(base, factor, scale)
+                if provisional:
+                    extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
+                    validate_case(apply_overrides(base_data, [(k.split("."), v) for k, v in {**provisional,
+                                                                                           **extra}.items()]),
+                                  f"convergence study, {factor} x {scale:g} ({provisional})")
+            else:
                 extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
                 data = apply_overrides(base_data, [(k.split("."), v) for k, v in {**over, **extra}.items()])
                 case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")

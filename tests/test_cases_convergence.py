@@ -79,6 +79,22 @@ def test_bad_levels_are_refused(mini, tmp_path, levels, message):
         cv.make_study(mini, tmp_path, levels)
 
 
+def test_a_level_the_machine_cannot_hold_is_refused_before_the_reference_runs(tmp_path, capsys):
+    """A particle level waits for the reference's DEM step (the common step), but its bed is checked against the
+    machine's memory at once: 15 million spheres are refused before any run, by the command too, naming the level."""
+    from wheelsoil.cases.cli import EXIT_INPUT, main
+    from wheelsoil.cases.schema import load_case
+
+    with pytest.raises(WheelsoilInputError, match=r"particle_size x 0.1 .* spheres while it is prepared"):
+        cv.make_study(load_case("smoke-1g-steer"), tmp_path, {"particle_size": (1, 0.1)})
+    out = tmp_path / "c"
+    assert main(["convergence", "smoke-1g-steer", "--factors", "particle_size", "--particle-size-levels", "1,0.1",
+                 "--out", str(out)]) == EXIT_INPUT
+    err = " ".join(capsys.readouterr().err.split())
+    assert "particle_size x 0.1" in err and "GiB" in err and "Traceback" not in err
+    assert not (out / "cases").exists()
+
+
 def test_parse_levels():
     assert cv.parse_levels("1, 0.8,0.64", "particle_size") == (1.0, 0.8, 0.64)
     assert cv.parse_levels(None, "depth") == cv.DEFAULT_LEVELS["depth"]
