@@ -312,8 +312,9 @@ def load_bound(bed: BedSpec, wheel: WheelGeometry) -> tuple[float, float, float]
     (:func:`wheelsoil.bearing.rectangular_footing`) at that depth on the footprint there, the wheel's width times the
     chord of its outer (grouser-tip) circle, for the strongest soil of :data:`BOUND_PACKING` and
     :data:`BOUND_FRICTION_ANGLE` (no cohesion: the DEM has none) under the bed's gravity. It is generous (for the CMU
-    rig about ten times what the lab's sand carries there), so it refuses only a load no bed of the case could carry,
-    before any work: a load in the wrong unit or another rig's."""
+    wheels about twenty times the most the measured sand carried when they were pressed to that depth,
+    ``force_displacement/wheel_sinkage.csv``), so it refuses only a load no bed of the case could carry, before any
+    work: a load in the wrong unit or another rig's."""
     sink = 0.5 * wheel.radius
     outer = wheel.radius + (wheel.grouser_height if wheel.grouser_count else 0.0)
     length = 2.0 * math.sqrt(outer ** 2 - (wheel.radius - sink) ** 2)
