@@ -8,9 +8,9 @@ and whole drive, at the run's DEM step) over the whole-run throughputs the proje
     wall = particles x steps / throughput,   throughput between CPU_SLOW and CPU_FAST particle-steps/s per core,
 
 the fast end the soil alone at its best (the 53k bed, 9.0e6 on 2 cores, ``benchmarks/README.md`` run 13: no coupled
-run steps faster than its soil; the CMU twin's rigid wheel alone made 4.7e6), the slow end the flexible smoke wheel beside other jobs (12,046 particles, 8.2 ms a step on
-2 cores: 1.5e6; the mini wheel 3,852 particles at 3.35 ms: 1.2e6; ``docs/force-balance``), whose sub-steps cost as
-much as the soil. A run that turns steady stops before its whole drive (the CMU twin's after 7-18 s of 20), so the
+run steps faster than its soil; the CMU twin's rigid wheel alone made 4.7e6), the slow end the flexible wheels beside
+other jobs (the smoke wheel, 12,046 particles at 8.2 ms a step on 2 cores: 1.5e6; the mini wheel, 3,852 particles at
+3.35 ms: 1.2e6; ``docs/force-balance``), whose sub-steps cost as much as the soil. A run that turns steady stops before its whole drive (the CMU twin's after 7-18 s of 20), so the
 slow end is an upper figure on a machine like the project's; a bed not yet in the cache is prepared first, at the
 soil's own faster step rate, and is not counted. Runs sharing the machine's cores add no throughput (two workers on
 two cores took as long in all as one after the other, ``benchmarks/README.md``): n runs cost n times one.
