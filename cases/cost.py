@@ -10,10 +10,11 @@ and whole drive, at the run's DEM step) over the whole-run throughputs the proje
 the fast end the soil alone at its best (the 53k bed, 9.0e6 on 2 cores, ``benchmarks/README.md`` run 13: no coupled
 run steps faster than its soil; the CMU twin's rigid wheel alone made 4.7e6), the slow end the flexible wheels beside
 other jobs (the smoke wheel, 12,046 particles at 8.2 ms a step on 2 cores: 1.5e6; the mini wheel, 3,852 particles at
-3.35 ms: 1.2e6; ``docs/force-balance``), whose sub-steps cost as much as the soil. A run that turns steady stops before its whole drive (the CMU twin's after 7-18 s of 20), so the
-slow end is an upper figure on a machine like the project's; a bed not yet in the cache is prepared first, at the
-soil's own faster step rate, and is not counted. Runs sharing the machine's cores add no throughput (two workers on
-two cores took as long in all as one after the other, ``benchmarks/README.md``): n runs cost n times one.
+3.35 ms: 1.2e6; ``docs/force-balance``), whose sub-steps cost as much as the soil. A run that turns steady stops
+before its whole drive (the CMU twin's after 7-18 s of 20), so the slow end is an upper figure on a machine like the
+project's; a bed not yet in the cache is prepared first, at the soil's own faster step rate, and is not counted. Runs
+sharing the machine's cores add no throughput (two workers on two cores took as long in all as one after the other,
+``benchmarks/README.md``): n runs cost n times one.
 
 A budget is refused before any run when even the fast end cannot hold the runs, and said to be at risk when the slow
 end cannot (:func:`check_budget`).
@@ -84,8 +85,8 @@ def run_cost(plan, *, finished_walls=(), cores: int | None = None) -> RunCost:
     work = plan.particles * steps
     return RunCost(work / (CPU_FAST * cores), work / (CPU_SLOW * cores),
                    f"{plan.particles:,} particles x {steps:,} DEM steps of the longest protocol at "
-                   f"{CPU_SLOW * cores:.2g}-{CPU_FAST * cores:.2g} particle-steps/s on {cores} cores: the slowest whole "
-                   "runs measured to the soil alone at its best; a run steady early stops sooner")
+                   f"{CPU_SLOW * cores:.2g}-{CPU_FAST * cores:.2g} particle-steps/s on {cores} cores: the slowest "
+                   "whole runs measured to the soil alone at its best; a run steady early stops sooner")
 
 
 def _fitting(walls: list[float], seconds: float) -> int:

@@ -305,13 +305,14 @@ def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corn
 
 
 @ti.func
-def kept_contact(e: ti.i32, i: ti.i32, p: vec3, ri: ti.f64, n_old: ti.i32, claimed: ti.i32, v: ti.template(), omega: ti.template(), mass: ti.template(), inertia: ti.template(),
-                 cand: ti.template(), code: ti.template(), bary: ti.template(), normal: ti.template(),
-                 overlap: ti.template(), f_wheel: ti.template(), m_wheel: ti.template(), xi_new: ti.template(),
-                 roll_new: ti.template(), stiffness: ti.template(), hist_n: ti.template(), hist_xi: ti.template(),
-                 hist_roll: ti.template(), xw: ti.template(), vw: ti.template(), ww: ti.template(),
-                 inv_mass_w: ti.template(), tri: ti.template(), half_t: ti.template(), e_eff: ti.f64, g_eff: ti.f64,
-                 beta: ti.f64, mu_s: ti.f64, mu_r: ti.f64, rolling: ti.i32, dt: ti.f64):
+def kept_contact(e: ti.i32, i: ti.i32, p: vec3, ri: ti.f64, n_old: ti.i32, claimed: ti.i32, v: ti.template(),
+                 omega: ti.template(), mass: ti.template(), inertia: ti.template(), cand: ti.template(),
+                 code: ti.template(), bary: ti.template(), normal: ti.template(), overlap: ti.template(),
+                 f_wheel: ti.template(), m_wheel: ti.template(), xi_new: ti.template(), roll_new: ti.template(),
+                 stiffness: ti.template(), hist_n: ti.template(), hist_xi: ti.template(), hist_roll: ti.template(),
+                 xw: ti.template(), vw: ti.template(), ww: ti.template(), inv_mass_w: ti.template(),
+                 tri: ti.template(), half_t: ti.template(), e_eff: ti.f64, g_eff: ti.f64, beta: ti.f64, mu_s: ti.f64,
+                 mu_r: ti.f64, rolling: ti.i32, dt: ti.f64):
     """Phase C, kept entry ``e`` of sphere ``i`` (centre p, radius ri): the Hertz--Mindlin law with the history matched
     by normal (:func:`matched_history`; ``claimed`` the slots taken so far), the reaction and its moment for the
     wheel's nodes, the normal stiffness and the new history written at ``e``. Returns the force on the sphere, n x its

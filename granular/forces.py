@@ -90,27 +90,27 @@ def owner_contacts(
     own_x = x_r[i]
     own_v = v_m[i]
     own_w = w_i[i]
-    f, t, n_contacts = owned_pairs(i, own_x, own_v, own_w, x_r, v_m, w_i, pair_start, pair_j, pair_xi, pair_roll,
-                                   pair_rev, touching_flag, partner_slot, e_eff, g_eff, beta, mu_s, mu_r, rolling, dt,
-                                   period, inv_period)
-    return wall_contacts(i, own_x, own_v, own_w, f, t, n_contacts, wall_point, wall_normal, wall_props, xi_wall,
-                         roll_wall, wall_touching, wall_near, dt)
-
-
-@ti.func
-def owned_pairs(i, own_x, own_v, own_w, x_r: ti.template(), v_m: ti.template(), w_i: ti.template(),
-                pair_start: ti.template(), pair_j: ti.template(), pair_xi: ti.template(), pair_roll: ti.template(),
-                pair_rev: ti.template(), touching_flag: ti.template(), partner_slot: ti.template(), e_eff, g_eff,
-                beta, mu_s, mu_r, rolling, dt, period, inv_period):
-    """The pairs particle ``i`` owns (its state ``own_x``, ``own_v``, ``own_w`` as stored: position and radius, velocity
-    and mass, spin and inertia): force [N] and torque [N m] on i and the number touching, each pair's history and
-    partner slot written (:func:`owner_contacts`)."""
     xi_pos = own_x.xyz
     ri = own_x[3]
     vi = own_v.xyz
     mi = own_v[3]
     wi = own_w.xyz
     ii = own_w[3]
+    f, t, n_contacts = owned_pairs(i, xi_pos, ri, vi, mi, wi, ii, x_r, v_m, w_i, pair_start, pair_j, pair_xi,
+                                   pair_roll, pair_rev, touching_flag, partner_slot, e_eff, g_eff, beta, mu_s, mu_r,
+                                   rolling, dt, period, inv_period)
+    return wall_contacts(i, xi_pos, ri, vi, mi, wi, ii, f, t, n_contacts, wall_point, wall_normal, wall_props,
+                         xi_wall, roll_wall, wall_touching, wall_near, dt)
+
+
+@ti.func
+def owned_pairs(i, xi_pos, ri, vi, mi, wi, ii, x_r: ti.template(), v_m: ti.template(), w_i: ti.template(),
+                pair_start: ti.template(), pair_j: ti.template(), pair_xi: ti.template(), pair_roll: ti.template(),
+                pair_rev: ti.template(), touching_flag: ti.template(), partner_slot: ti.template(), e_eff, g_eff,
+                beta, mu_s, mu_r, rolling, dt, period, inv_period):
+    """The pairs particle ``i`` owns (its position ``xi_pos``, radius ``ri``, velocity ``vi``, mass ``mi``, spin ``wi``,
+    inertia ``ii``): force [N] and torque [N m] on i and the number touching, each pair's history and partner slot
+    written (:func:`owner_contacts`)."""
     f = vec3(0.0, 0.0, 0.0)
     t = vec3(0.0, 0.0, 0.0)
     n_contacts = 0
@@ -169,18 +169,13 @@ def owned_pairs(i, own_x, own_v, own_w, x_r: ti.template(), v_m: ti.template(), 
 
 
 @ti.func
-def wall_contacts(i, own_x, own_v, own_w, f, t, n_contacts, wall_point: ti.template(), wall_normal: ti.template(),
-                  wall_props: ti.template(), xi_wall: ti.template(), roll_wall: ti.template(),
+def wall_contacts(i, xi_pos, ri, vi, mi, wi, ii, f, t, n_contacts, wall_point: ti.template(),
+                  wall_normal: ti.template(), wall_props: ti.template(), xi_wall: ti.template(),
+                  roll_wall: ti.template(),
                   wall_touching: ti.template(), wall_near: ti.template(), dt):
     """The walls particle ``i`` touches or is near, added to its force ``f`` [N], torque ``t`` [N m] and contact count
     (in that order after its pairs, so the sums are those of one loop); its wall histories and touching mask kept
     (:func:`owner_contacts`). Returns the three."""
-    xi_pos = own_x.xyz
-    ri = own_x[3]
-    vi = own_v.xyz
-    mi = own_v[3]
-    wi = own_w.xyz
-    ii = own_w[3]
     mask = wall_touching[i]
     candidates = mask | wall_near[i]
     new_mask = 0
