@@ -218,29 +218,26 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
             over = level_overrides(base, factor, scale, reference_time_step,
                                    common if factor == "particle_size" else None)
             lv = Level(factor, scale, over or {})
-            if over is None:
-                # the level waits for the reference's DEM step; everything else about it (its bed against the
-                # machine's memory, the wheel against the bin) is checked now, so that no level the machine cannot
-                # hold is found out only after the reference has run
-                provisional = level_overrides(base, factor, scale)
-                if provisional:
-                    extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
-                    validate_case(apply_overrides(base_data, [(k.split("."), v) for k, v in {**provisional,
-                                                                                           **extra}.items()]),
-                                  f"convergence study, {factor} x {scale:g} ({provisional})")
-            else:
-                extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
-                data = apply_overrides(base_data, [(k.split("."), v) for k, v in {**over, **extra}.items()])
-                case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over or 'reference'})")
-                if case.case_hash() == reference_hash:
-                    lv.case = reference_case  # every factor's scale 1 that changes nothing is the base case itself
-                    study.reference = lv
-                else:
-                    data["case"]["name"] = f"{base.name}-{factor}x{scale:g}" + (
-                        "-common-step" if factor == "particle_size" and scale == 1.0 else "")
-                    lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over})")
-                lv.folder = out / "cases" / lv.case.case_hash()
             study.levels[factor].append(lv)
+            # a level that waits for the reference's DEM step (over None) is validated now on everything else (its
+            # bed against the machine's memory, the wheel against the bin), so that no level the machine cannot hold
+            # is found out only after the reference has run; a time-step level differs from it in the step alone
+            keys = over if over is not None else level_overrides(base, factor, scale)
+            if keys is None:
+                continue
+            extra = {"test.drive_time": level_drive_time} if scale != 1.0 else {}
+            data = apply_overrides(base_data, [(k.split("."), v) for k, v in {**keys, **extra}.items()])
+            case = validate_case(data, f"convergence study, {factor} x {scale:g} ({keys or 'reference'})")
+            if over is None:
+                continue
+            if case.case_hash() == reference_hash:
+                lv.case = reference_case  # every factor's scale 1 that changes nothing is the base case itself
+                study.reference = lv
+            else:
+                data["case"]["name"] = f"{base.name}-{factor}x{scale:g}" + (
+                    "-common-step" if factor == "particle_size" and scale == 1.0 else "")
+                lv.case = validate_case(data, f"convergence study, {factor} x {scale:g} ({over})")
+            lv.folder = out / "cases" / lv.case.case_hash()
     if study.reference is None:  # no factor's scale 1 is the base case: the reference runs on its own
         study.reference = Level("reference", 1.0, {}, reference_case, out / "cases" / reference_hash)
     return study

@@ -69,4 +69,3 @@ def budget_said(sweep, budget_hours: float | None, what: str = "cases", *, same_
     else:
         costs = [run_cost(plan(c.case)) for c in todo]
     return check_budget(costs, budget_hours, what)
-
