@@ -5,46 +5,34 @@ the structure over that interval in stable sub-steps (:meth:`Structure.advance`)
 positions, velocities and the surface triangles. A set of nodes can be tied to a rigid *hub* whose
 six degrees of freedom are each prescribed (kinematic drive) or free (force drive); a clamped support
 is a hub held still. ``rigid=True`` ties every node to the hub: the rigid-wheel variant with the same
-surface.
+surface. The hub's drive and state (:mod:`.structure_hub`) and what the structure reports (:mod:`.structure_readout`)
+are mixed in; the class itself builds the device arrays and keeps the clock and the stepping.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
-import taichi as ti
 
 from wheelsoil import runtime
 from wheelsoil.errors import SimulationUnstableError, WheelsoilInputError
 
 from . import integrator as itg
 from . import stepper
-from .beam import beam_energies, beam_forces
 from .mesh import StructureMesh
 from .stability import assembled_critical_frequency
 from .structure_arrays import element_arrays, hub_arrays, node_arrays, slot_arrays
-from .shell import shell_energies, shell_forces
+from .structure_hub import HubDrive
+from .structure_readout import MomentumAccount, StructureReadout
+
+__all__ = ["DEFAULT_SAFETY", "MomentumAccount", "Structure"]
 
 #: Fraction of the critical central-difference step used by default.
 DEFAULT_SAFETY = 0.9
 
 
-@dataclass(frozen=True)
-class MomentumAccount:
-    """What changed a structure's linear momentum over ``duration`` [s] (:meth:`Structure.take_impulses`), each an
-    impulse [N s] (3-vector): ``contact``, the external (contact) forces as the sub-steps applied them; ``damping``,
-    the structural damping; ``reaction``, the reactions of the hub's prescribed dofs. The rig's applied force and
-    gravity, constant over an interval, are the caller's to add."""
-
-    contact: np.ndarray
-    damping: np.ndarray
-    reaction: np.ndarray
-    duration: float
-
-
-class Structure:
+class Structure(HubDrive, StructureReadout):
     """A shell/beam structure advanced by explicit central differences on Taichi.
 
     Parameters
@@ -247,35 +235,7 @@ class Structure:
                 "non-finite state). Reduce the time step (safety) or the loads."
             )
 
-    # ------------------------------------------------------------------ hub
-    def _hub_state(self) -> np.ndarray:
-        if not self.hub_nodes.size:
-            raise WheelsoilInputError("this structure has no hub")
-        return self.arrays.hub.to_numpy()
-
-    def drive_hub(self, *, velocity=None, angular_velocity=None, free_translation=None, free_rotation=None,
-                  force=None, moment=None) -> None:
-        """Set the hub's drive, held until changed.
-
-        velocity, angular_velocity: prescribed velocity [m/s] and spin [rad/s] (global frame) of the
-            prescribed degrees of freedom.
-        free_translation, free_rotation: three booleans each; True makes that dof force-driven.
-        force, moment: load the rig applies to the hub [N, N m] (acts on the free dofs; on prescribed
-            ones it only changes the reported reaction).
-        """
-        s = self._hub_state()
-        for row, val in ((itg.HUB_CMD_VELOCITY, velocity), (itg.HUB_CMD_SPIN, angular_velocity),
-                         (itg.HUB_APPLIED_FORCE, force), (itg.HUB_APPLIED_MOMENT, moment)):
-            if val is not None:
-                arr = np.asarray(val, float).reshape(3)
-                if not np.all(np.isfinite(arr)):
-                    raise WheelsoilInputError(f"hub drive value {arr.tolist()} must be finite")
-                s[row] = arr
-        for row, val in ((itg.HUB_FREE_TRANSLATION, free_translation), (itg.HUB_FREE_ROTATION, free_rotation)):
-            if val is not None:
-                s[row] = np.asarray(val, bool).reshape(3).astype(float)
-        self.arrays.hub.from_numpy(s)
-
+    # ------------------------------------------------------------------ rigid moves
     def translate(self, offset) -> None:
         """Move the whole structure rigidly by ``offset`` [m] (nodes, the anchors of held contact forces and the
         hub; velocities, rotations and forces unchanged): a moving soil patch re-centring the wheel."""
@@ -289,186 +249,3 @@ class Structure:
             s[itg.HUB_POSITION] += off
             self.arrays.hub.from_numpy(s)
         self.hub_center0 = self.hub_center0 + off
-
-    def set_hub_state(self, *, velocity=None, angular_velocity=None) -> None:
-        """Set the hub's current velocity and spin (e.g. to start a free dof moving)."""
-        s = self._hub_state()
-        if velocity is not None:
-            s[itg.HUB_VELOCITY] = np.asarray(velocity, float).reshape(3)
-        if angular_velocity is not None:
-            s[itg.HUB_SPIN] = np.asarray(angular_velocity, float).reshape(3)
-        self.arrays.hub.from_numpy(s)
-
-    @property
-    def hub_position(self) -> np.ndarray:
-        return self._hub_state()[itg.HUB_POSITION].copy()
-
-    @property
-    def hub_velocity(self) -> np.ndarray:
-        return self._hub_state()[itg.HUB_VELOCITY].copy()
-
-    @property
-    def hub_angular_velocity(self) -> np.ndarray:
-        return self._hub_state()[itg.HUB_SPIN].copy()
-
-    @property
-    def hub_applied_force(self) -> np.ndarray:
-        """The force the rig applies to the hub [N] (``drive_hub(force=...)``), held until changed."""
-        return self._hub_state()[itg.HUB_APPLIED_FORCE].copy()
-
-    @property
-    def hub_rotation(self) -> np.ndarray:
-        self._hub_state()
-        return self.arrays.hub_rot.to_numpy()[0]
-
-    def hub_reaction(self, reset: bool = True) -> tuple[np.ndarray, np.ndarray]:
-        """Mean force [N] and moment about the hub centre [N m] the rig applied to the prescribed hub
-        dofs since the last reset (zero on free dofs)."""
-        s = self._hub_state()
-        scal = self.arrays.hub_scalar.to_numpy()
-        k = max(scal[itg.HUB_SAMPLES], 1.0)
-        f, m = s[itg.HUB_REACTION_FORCE] / k, s[itg.HUB_REACTION_MOMENT] / k
-        if reset:
-            s[itg.HUB_REACTION_FORCE] = 0.0
-            s[itg.HUB_REACTION_MOMENT] = 0.0
-            scal[itg.HUB_SAMPLES] = 0.0
-            self.arrays.hub.from_numpy(s)
-            self.arrays.hub_scalar.from_numpy(scal)
-        return f, m
-
-    def linear_momentum(self) -> np.ndarray:
-        """The structure's linear momentum [kg m/s] as its integrator carries it: each free node's m v, and the hub's
-        whole mass (its own and its nodes') times its velocity."""
-        free = self._free
-        p = (self._node_mass[free, None] * self.arrays.v.to_numpy()[free]).sum(axis=0)
-        if self.hub_nodes.size:
-            p = p + self._hub_mass * self._hub_state()[itg.HUB_VELOCITY]
-        return p
-
-    def gravity_force(self) -> np.ndarray:
-        """The weight of the whole structure [N]: every node's mass and the hub's own, times gravity."""
-        total = self._node_mass[self._free].sum() + self._hub_mass
-        return total * np.asarray(self.gravity, float)
-
-    def take_impulses(self) -> MomentumAccount:
-        """What changed the structure's momentum since the last call (or its construction), and zero the accounts:
-        the impulses [N s] of the external (contact) forces as the sub-steps applied them, of the damping, and of the
-        hub's held dofs' reactions, with the time they span [s] (:class:`MomentumAccount`). With the rig's applied
-        force and gravity, they add up to the change of :meth:`linear_momentum` (the internal forces cancel)."""
-        a = self.arrays
-        contact = a.j_ext.to_numpy().sum(axis=0)
-        damping = a.j_damp.to_numpy().sum(axis=0)
-        # the reaction's mean over the steps (of equal length) times the time they span
-        reaction = self.hub_reaction(reset=False)[0] * self._account_time if self.hub_nodes.size else np.zeros(3)
-        account = MomentumAccount(contact=contact, damping=damping, reaction=reaction, duration=self._account_time)
-        self.reset_impulses()
-        return account
-
-    def reset_impulses(self) -> None:
-        """Zero the impulse accounts (:meth:`take_impulses`) without reading them: an interval's record starts here."""
-        self.arrays.j_ext.fill(0.0)
-        self.arrays.j_damp.fill(0.0)
-        if self.hub_nodes.size:
-            self.hub_reaction(reset=True)
-        self._account_time = 0.0
-
-    # ------------------------------------------------------------------ state out
-    def device_arrays(self) -> stepper.StructureArrays:
-        """The Taichi ndarrays (:class:`~.stepper.StructureArrays`, valid for the structure's lifetime). What a
-        coupling reads and writes:
-
-        ``x``, ``v``, ``w``: node positions [m], velocities [m/s] and spins [rad/s]; ``f_ext``,
-        ``m_ext``: external nodal forces [N] and moments [N m], held over :meth:`advance` (a coupling
-        may write them in place instead of passing arrays); ``k_ext`` [N/m], ``x_anchor`` [m]: the
-        stiffness of those forces and the node positions they were evaluated at (the node feels
-        f_ext - k_ext (x - x_anchor)); ``mass``: lumped node masses [kg]; ``hub``: the hub state rows
-        (``flexwheel.integrator.HUB_*``; row 0 is the hub centre).
-        """
-        return self.arrays
-
-    def positions(self) -> np.ndarray:
-        """Node positions (N, 3) [m]."""
-        return self.arrays.x.to_numpy()
-
-    def velocities(self) -> np.ndarray:
-        """Node velocities (N, 3) [m/s] (at the last half step)."""
-        return self.arrays.v.to_numpy()
-
-    def angular_velocities(self) -> np.ndarray:
-        return self.arrays.w.to_numpy()
-
-    def rotations(self) -> np.ndarray:
-        """Node rotation matrices (N, 3, 3) from the reference configuration."""
-        return self.arrays.rot.to_numpy()
-
-    def displacements(self) -> np.ndarray:
-        return self.positions() - self.mesh.nodes
-
-    def nodal_forces(self) -> tuple[np.ndarray, np.ndarray]:
-        """Total force and moment on every node at the last step (elastic + external + gravity)."""
-        return self.arrays.f_tot.to_numpy(), self.arrays.m_tot.to_numpy()
-
-    @property
-    def surface_triangles(self) -> np.ndarray:
-        """Node indices (S, 3) of the contact-surface facets."""
-        return self.mesh.triangles[self.mesh.surface]
-
-    def set_state(self, positions=None, velocities=None, rotations=None, angular_velocities=None) -> None:
-        """Overwrite node state arrays (for tests and restarts)."""
-        for key, val, shape in (("x", positions, (3,)), ("v", velocities, (3,)), ("rot", rotations, (3, 3)),
-                                ("w", angular_velocities, (3,))):
-            if val is not None:
-                arr = np.asarray(val, float)
-                if arr.shape != (self.mesh.n_nodes,) + shape or not np.all(np.isfinite(arr)):
-                    raise WheelsoilInputError(f"{key} must be a finite array of shape {(self.mesh.n_nodes,) + shape}")
-                getattr(self.arrays, key).from_numpy(arr)
-
-    def _launch_element_forces(self) -> None:
-        """Evaluate every element's corner forces and moments into the slot arrays (parallel kernels)."""
-        if self.rigid:
-            return
-        d = self.arrays
-        if self.n_facets:
-            shell_forces(d.x, d.rot, d.tri, d.frame0, d.local0, d.km, d.kb, d.slot_f, d.slot_m, 0)
-        if self.n_beams:
-            beam_forces(d.x, d.rot, d.ends, d.bframe0, d.blen0, d.rigidity, d.slot_f,
-                        d.slot_m, self._slot_beam_base)
-
-    def element_corner_forces(self) -> tuple[np.ndarray, np.ndarray]:
-        """Elastic force and moment on each element corner of the current state (facet corners, then
-        beam ends; zero for a rigid structure). No step is taken."""
-        self._launch_element_forces()
-        return self.arrays.slot_f.to_numpy(), self.arrays.slot_m.to_numpy()
-
-    def internal_forces(self) -> tuple[np.ndarray, np.ndarray]:
-        """Elastic nodal forces and moments (N, 3) of the current state (no step is taken)."""
-        n = self.mesh.n_nodes
-        if self.rigid:
-            return np.zeros((n, 3)), np.zeros((n, 3))
-        sf, sm = self.element_corner_forces()
-        nodes = np.concatenate([self.mesh.triangles.reshape(-1), self.mesh.beams.reshape(-1)])
-        f, m = np.zeros((n, 3)), np.zeros((n, 3))
-        np.add.at(f, nodes, sf[: len(nodes)])
-        np.add.at(m, nodes, sm[: len(nodes)])
-        return f, m
-
-    def strain_energy(self) -> float:
-        """Elastic energy stored in the elements [J]."""
-        if self.rigid:
-            return 0.0
-        d = self.arrays
-        total = 0.0
-        if self.n_facets:
-            e = ti.ndarray(ti.f64, shape=self.n_facets)
-            shell_energies(d.x, d.rot, d.tri, d.frame0, d.local0, d.km, d.kb, d.slot_f, d.slot_m, e)
-            total += float(e.to_numpy().sum())
-        if self.n_beams:
-            e = ti.ndarray(ti.f64, shape=self.n_beams)
-            beam_energies(d.x, d.rot, d.ends, d.bframe0, d.blen0, d.rigidity, d.slot_f, d.slot_m, e)
-            total += float(e.to_numpy().sum())
-        return total
-
-    def kinetic_energy(self) -> float:
-        """1/2 sum m v^2 + 1/2 sum I omega^2 over the nodes [J] (half-step velocities)."""
-        d = self.arrays
-        return float(itg.kinetic_energy(self.mesh.n_nodes, d.v, d.w, d.mass, d.inertia))
