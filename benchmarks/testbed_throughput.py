@@ -5,7 +5,8 @@ and a measured extrapolation to seed-004 scale (388,026 particles, the full-reso
    protocol (lower, settle, drive) and reports wall time per simulated second and peak memory; then keeps
    driving for ``--steps`` DEM steps with timers on the three parts of a coupled step -- the soil (DEM
    neighbour search, contact forces, integration), the wheel (its FE sub-steps over the DEM step) and the
-   wheel--soil contact (evaluation, and candidate rebuilds separately).
+   wheel--soil contact (evaluation, and candidate rebuilds separately); those steps alternate with as many of the
+   same bed alone in ``--rounds`` chunks, so that the coupled-over-soil ratio does not take the machine's drift.
 2. Seed-004 scale, each part measured in its own process so that its memory is its own:
    * the wheel at the preset's full resolution: mesh, stable step, time per FE sub-step, memory;
    * a bed of 388,026 spheres of 16--24 mm (``dem_throughput.memory_check``): memory while stepping;
@@ -340,6 +341,8 @@ def main(argv=None) -> int:
                          "step by part against the same bed alone (issue 37 item 2)")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.rounds < 1 or args.steps < 10 * args.rounds:
+        ap.error(f"--rounds {args.rounds} and --steps {args.steps}: give at least one round and 10 steps per round")
     if args.part:
         fn = {"fe-seed004": lambda: fe_seed004_part(min(args.steps, 200), args.arch),
               "dem-seed004": lambda: dem_seed004_part(args.arch), "base": lambda: base_part(args.arch),
