@@ -40,12 +40,9 @@ def node_update(
     w: ti.template(), mass: ti.template(), inertia: ti.template(), free: ti.template(), f_ext: ti.template(),
     k_ext: ti.template(), x_anchor: ti.template(), m_ext: ti.template(), slot_start: ti.template(),
     slot_list: ti.template(), slot_f: ti.template(), slot_m: ti.template(), f_tot: ti.template(),
-    m_tot: ti.template(), hub: ti.template(), j_ext: ti.template(), j_damp: ti.template(), n_elements: ti.i32,
+    m_tot: ti.template(), hub: ti.template(), j_ext: ti.template(), j_damp: ti.template(),
 ):
     """Gather node n's force and moment from its element slots; advance it if it is free.
-
-    ``n_elements``: the elements evaluated this step (facets and beams; 0 for a rigid structure, whose slots then hold
-    zeros and are not read: the CMU twin's rigid wheel gathers nothing at any of its 1,540-2,884 nodes).
 
     The damping acts on the node's velocity and spin relative to the hub's rigid-body motion
     (v - v_hub - omega_hub x (x - c_hub), omega - omega_hub), so a rolling wheel is not braked by it;
@@ -68,11 +65,10 @@ def node_update(
     # product changed how it fused the multiply-add, and the run's trajectory with it)
     j_ext[n] += dt * (f_ext[n] - k_ext[n] * (x[n] - x_anchor[n]))
     m = m_ext[n]
-    if n_elements > 0:
-        for k in range(slot_start[n], slot_start[n + 1]):
-            s = slot_list[k]
-            f += slot_f[s]
-            m += slot_m[s]
+    for k in range(slot_start[n], slot_start[n + 1]):
+        s = slot_list[k]
+        f += slot_f[s]
+        m += slot_m[s]
     f_tot[n] = f
     m_tot[n] = m
     if free[n]:

@@ -126,7 +126,7 @@ def _steps_serial(
             beam_element(e, x, rot, ends, bframe0, blen0, rigidity, slot_f, slot_m, 3 * n_facets, 1)
         for n in range(n_nodes):
             itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
-                            m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp, n_facets + n_beams)
+                            m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp)
         if n_hub > 0:
             itg.hub_update(dt, gravity, n_hub, hub_nodes, hub, hub_rot, hub_scalar, x, mass, inertia, f_tot, m_tot)
             for k in range(n_hub):
@@ -179,7 +179,7 @@ def steps_parallel(n_steps: int, beams: bool = True) -> GraphKernel:
                                      3 * n_facets, 1)
             for n in range(n_nodes):
                 itg.node_update(n, dt, damping, gravity, x, v, rot, w, mass, inertia, free, f_ext, k_ext, x_anchor,
-                                m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp, n_facets + n_beams)
+                                m_ext, slot_start, slot_list, slot_f, slot_m, f_tot, m_tot, hub, j_ext, j_damp)
             ti.loop_config(serialize=True)
             for _ in range(1):
                 if n_hub > 0:

@@ -114,7 +114,7 @@ class Structure(HubDrive, StructureReadout):
             else (mesh.nodes[hub].mean(axis=0) if hub.size else np.zeros(3))
         )
         self.hub_mass_total = float(hub_mass + self.mass[hub].sum())
-        self.arrays = stepper.StructureArrays(**element_arrays(mesh), **slot_arrays(mesh),
+        self.arrays = stepper.StructureArrays(**element_arrays(mesh), **slot_arrays(mesh, self.rigid),
                                               **node_arrays(mesh, self.mass, self.inertia, tied),
                                               **hub_arrays(mesh, hub, self.hub_center0, hub_mass, hub_inertia))
 

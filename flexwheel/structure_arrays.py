@@ -42,14 +42,17 @@ def element_arrays(mesh: StructureMesh) -> dict:
     return d
 
 
-def slot_arrays(mesh: StructureMesh) -> dict:
+def slot_arrays(mesh: StructureMesh, rigid: bool = False) -> dict:
     """The element corners: each node's corner slots (slot_start, slot_list; facets' corners first, then beams'
-    ends) and the corners' forces and moments (slot_f, slot_m)."""
+    ends) and the corners' forces and moments (slot_f, slot_m). A ``rigid`` structure evaluates no element, so its
+    nodes gather from no slot (every run empty; the slots keep their size, which checkpoints hold): the CMU twin's
+    rigid wheel then reads nothing per node that could only be zero (benchmarks/README.md, 2026-11-29)."""
     n = mesh.n_nodes
     slot_node = np.concatenate([mesh.triangles.reshape(-1), mesh.beams.reshape(-1)]).astype(np.int64)
     order = np.argsort(slot_node, kind="stable")
     start = np.zeros(n + 1, np.int32)
-    np.add.at(start, slot_node + 1, 1)
+    if not rigid:
+        np.add.at(start, slot_node + 1, 1)
     n_slots = len(slot_node)
     return {"slot_start": _nd(ti.i32, np.cumsum(start).astype(np.int32)), "slot_list": _nd(ti.i32, order.astype(np.int32)),
             "slot_f": _vec(np.zeros((n_slots, 3))), "slot_m": _vec(np.zeros((n_slots, 3)))}
