@@ -6,10 +6,10 @@ a patch against the commit it names, kept so that its measurement can be repeate
     git apply benchmarks/experiments/f32-arithmetic.patch
     python benchmarks/experiments/alternate.py --env WHEELSOIL_F32 --values 0 1 --rounds 4 --steps 1000
 
-Each process loads the bed from the bed cache (``benchmarks/dem_throughput.py``'s, prepared once), steps 200 untimed,
-then times ``--steps``; the rounds alternate the variants so that the machine's drift falls on all of them alike. It
-prints each process's ms per step and CPU ms per step, and the ratios of the first variant's time to each other's, per
-round, their median and best against best.
+Each process loads the bed from the bed cache (``benchmarks/dem_throughput.py``'s, prepared once) and times
+``--steps`` after 200 untimed, with that benchmark's own stepping; the rounds alternate the variants so that the
+machine's drift falls on all of them alike. It prints each process's ms per step and particle-steps per second, and
+the ratios of the first variant's time to each other's, per round, their median and best against best.
 """
 
 from __future__ import annotations
@@ -20,13 +20,14 @@ import os
 import statistics
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
 
 def child(steps: int) -> dict:
+    """One variant's timing: the DEM benchmark's own stepping (:func:`dem_throughput.run_wheelsoil`, 200 steps of
+    warm-up) on its bed."""
     sys.path.insert(0, str(HERE.parent))
     from wheelsoil.runtime import init
 
@@ -36,13 +37,8 @@ def child(steps: int) -> dict:
     from wheelsoil.granular import prepare_bed
 
     bed = prepare_bed(dem_throughput.bench_spec(argparse.Namespace(length=1.6, width=1.0, depth=0.26)))
-    scene = bed.to_scene(headroom=0.05)
-    scene.step(200)
-    t0, c0 = time.perf_counter(), time.process_time()
-    scene.step(steps)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    return {"ms_per_step": 1e3 * wall / steps, "cpu_ms_per_step": 1e3 * cpu / steps,
-            "particle_steps_per_s": scene.n_particles * steps / wall}
+    res = dem_throughput.run_wheelsoil(bed, steps, 200)
+    return {"ms_per_step": 1e3 * res["wall_s"] / res["steps"], "particle_steps_per_s": res["particle_steps_per_s"]}
 
 
 def main(argv=None) -> int:
@@ -66,8 +62,8 @@ def main(argv=None) -> int:
                                  capture_output=True, text=True, check=True)
             res = json.loads(out.stdout.strip().splitlines()[-1])
             times[v].append(res["ms_per_step"])
-            print(f"round {r + 1} {args.env}={v}: {res['ms_per_step']:.3f} ms/step, {res['cpu_ms_per_step']:.3f} CPU ms,"
-                  f" {res['particle_steps_per_s'] / 1e6:.2f} M particle-steps/s", flush=True)
+            print(f"round {r + 1} {args.env}={v}: {res['ms_per_step']:.3f} ms/step, "
+                  f"{res['particle_steps_per_s'] / 1e6:.2f} M particle-steps/s", flush=True)
     base = args.values[0]
     for v in args.values[1:]:
         per_round = [b / o for b, o in zip(times[base], times[v])]
