@@ -4,9 +4,10 @@ The sweeps' cases take one to several hours each on 2 cores, so they run one at 
 finished case lets be judged (the README's "Queue order"), not the sweeps' own order. The queue is a JSON list, read
 again before each entry (so it can be reordered while a case runs), with entries of two kinds:
 
-* ``[sweep, wheel preset, steering angle, commanded slip, seed or null]``: the one case of the sweep preset
-  (``cases/presets/sweeps/<sweep>.toml``, run into ``RUNS/<sweep>``) at that wheel and steering angle [deg], whose
-  commanded slip is within 0.05 of the one given, at that seed (null: any; it must match one case only);
+* ``[sweep, wheel preset, steering angle, commanded slip, seed or null, drive or absent]``: the one case of the sweep
+  preset (``cases/presets/sweeps/<sweep>.toml``, run into ``RUNS/<sweep>``) at that wheel and steering angle [deg],
+  whose commanded slip is within 0.05 of the one given, at that seed (null: any) and drive [s] (absent: any; a sweep
+  with a longer drive of one trial, ``cmu_sweep.LONGER_DRIVES``, has two cases of it); it must match one case only;
 * ``["convergence", out folder, case file, factor, level drive time]``: ``wheelsoil convergence`` of one factor at x1
   and x2 (the bin checks; ``RUNS/`` in the out folder is the ``--runs`` folder), its reference the case file itself: a
   finished sweep case under ``RUNS/*/cases`` with the same case hash is linked into ``out/cases`` first
@@ -80,18 +81,19 @@ def recorded_cases(recorded: Path, sweep: str) -> set[str]:
         return {row["case_hash"] for row in csv.DictReader(f)}
 
 
-def run_sweep_case(runs: Path, name: str, wheel: str, angle: float, slip: float, seed,
+def run_sweep_case(runs: Path, name: str, wheel: str, angle: float, slip: float, seed, drive: float | None = None,
                    recorded: Path | None = None) -> None:
-    """The one case of sweep ``name`` at that wheel, steering angle, slip (within 0.05) and seed; skipped where it has
-    finished under ``runs`` or is recorded under ``recorded`` (:func:`recorded_cases`)."""
+    """The one case of sweep ``name`` at that wheel, steering angle, slip (within 0.05), seed and drive [s] (None:
+    any); skipped where it has finished under ``runs`` or is recorded under ``recorded`` (:func:`recorded_cases`)."""
     from wheelsoil.cases.sweep import Sweep, load_sweep, run_sweep, write_summary
 
     sweep = load_sweep(name, runs / name)
     hits = [c for c in sweep.cases if c.values.get("wheel.preset") == wheel
             and float(c.values.get("test.slip_angle")) == angle and abs(float(c.values["test.slip"]) - slip) < 0.05
-            and (seed is None or c.values.get("case.seed") == seed)]
+            and (seed is None or c.values.get("case.seed") == seed)
+            and (drive is None or float(c.values.get("test.drive_time")) == float(drive))]
     if len(hits) != 1:
-        log(f"{name} {wheel} {angle} {slip} {seed}: {len(hits)} matching cases, not one; skipped")
+        log(f"{name} {wheel} {angle} {slip} {seed} {drive}: {len(hits)} matching cases, not one; skipped")
         return
     case = hits[0]
     if case.finished:

@@ -68,6 +68,24 @@ def test_conditions_outside_the_rigs_range_are_refused_at_their_key(override, ke
         load_case("cmu-grouser", [override])
 
 
+def test_a_longer_drive_copies_the_one_row_it_names_and_refuses_an_ambiguous_name():
+    """cmu_sweep.longer_drives: a copy of the named trial's row with the longer drive, nothing else changed; an entry
+    that names no row, or more than one, is an input error naming the trial."""
+    from wheelsoil.cases.cmu_sweep import longer_drives
+    from wheelsoil.errors import WheelsoilInputError
+
+    rows = [{"wheel.preset": "cmu-k10-grouser", "case.seed": 1, "test.slip": s, "test.slip_angle": a,
+             "test.load": 23.0, "test.drive_time": 20.0} for a, s in ((30.0, 0.497), (75.0, 0.499), (75.0, 0.9))]
+    (copy,) = longer_drives(rows, (("grouser", 75.0, 0.5, 30.0),))
+    assert copy == {**rows[1], "test.drive_time": 30.0} and rows[1]["test.drive_time"] == 20.0
+    assert longer_drives(rows, ()) == []
+    for entry in (("grouser", 45.0, 0.5, 30.0), ("smooth", 75.0, 0.5, 30.0)):
+        with pytest.raises(WheelsoilInputError, match="matches 0 rows"):
+            longer_drives(rows, (entry,))
+    with pytest.raises(WheelsoilInputError, match="matches 2 rows"):
+        longer_drives(rows + [dict(rows[1])], (("grouser", 75.0, 0.5, 30.0),))
+
+
 def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(measured_dir, tmp_path):
     """The committed sweep presets are what the generator writes from the measured files; the full sweep has one
     case per trial and the comparison (validate --model) pairs every measured trial, braking and dragged included,

@@ -157,6 +157,26 @@ def test_the_twin_queue_skips_a_case_recorded_in_the_repository(tmp_path, monkey
     assert started == [at[1].folder.name]  # the recorded one skipped, the other run
 
 
+def test_the_twin_queue_tells_a_longer_drive_from_the_first_run_of_the_same_trial(tmp_path, monkeypatch):
+    """A sweep with a longer drive of one trial (cmu_sweep.LONGER_DRIVES) holds two cases of it: a queue entry without
+    a drive matches both and runs neither (said in the log); with a drive it runs that one only."""
+    queue = _load("cmu_twin_queue")
+    from wheelsoil.cases import sweep as sweeps
+
+    runs, started = tmp_path / "runs", []
+    monkeypatch.setattr(sweeps, "run_sweep", lambda s, workers: started.append(s.cases[0].folder.name) or "done")
+    monkeypatch.setattr(sweeps, "write_summary", lambda s: None)
+    cases = sweeps.load_sweep("cmu-candidate-closed-wheel", runs / "cmu-candidate-closed-wheel").cases
+    at75 = {float(c.values["test.drive_time"]): c.folder.name for c in cases
+            if float(c.values["test.slip_angle"]) == 75.0}
+    assert sorted(at75) == [20.0, 30.0]
+    queue.run_sweep_case(runs, "cmu-candidate-closed-wheel", "cmu-k10-grouser", 75.0, 0.5, None)
+    assert started == []
+    for drive in (30.0, 20.0):
+        queue.run_sweep_case(runs, "cmu-candidate-closed-wheel", "cmu-k10-grouser", 75.0, 0.5, None, drive)
+    assert started == [at75[30.0], at75[20.0]]
+
+
 def test_the_drum_fill_counts_the_grains_inside_an_open_wheel():
     """docs/cmu_twin_runs.py's drum fill: the grains whose centres lie inside the tread and between the side planes of
     a wheel yawed by the steering angle, their solid volume over the drum's (at 90 deg the axle lies along the bin)."""
