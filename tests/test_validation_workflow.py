@@ -87,3 +87,31 @@ def test_a_rival_fitted_in_place_of_two_members_is_quoted_at_its_best():
                                       dict(rival, replaces="sidewall", bic_vs_accepted=461.5)]}]}
     line = next(v for v in verdict_lines(findings) if v.startswith("ambiguous"))
     assert "a1 ~ load in place of theta_m_slip" in line and "-40.3" in line and "461.5" not in line
+
+
+def test_a_deferred_mechanism_is_said_and_each_verdict_quotes_its_own_rivals():
+    """A step that deferred a mechanism (validation.discovery: a rival beat it, another was accepted first) says so,
+    and the rivals fitted against each mechanism checked are quoted beside that mechanism only."""
+    from wheelsoil.validation.report import verdict_lines
+
+    drift = dict(name="kphi_prime ~ signed_slip", description="k'phi varying linearly with the signed slip",
+                 replaces="theta_m_slip", against="theta_m_slip", bic_vs_accepted=-6.0, delta_bic=-80.0, rate=0.3)
+    near = dict(drift, name="cohesion ~ load", description="cohesion varying with load", replaces="sidewall",
+                against="sidewall", bic_vs_accepted=4.0)
+    accepted = {"name": "sidewall", "parameters": {}, "step": 0, "delta_bic": -90.0, "gain": 0.1, "gain_std": 0.01,
+                "explained": 0.8, "source": "Iagnemma"}
+    findings = {"accepted": [accepted], "partial": [], "unexplained": [], "baseline": {"unidentified": [], "at_bounds": {}},
+                "steps": [{"step": 0, "ambiguity": [], "deferred": [["theta_m_slip", "kphi_prime ~ signed_slip"]],
+                           "rivals": [drift, near]},
+                          {"step": 1, "ambiguity": ["theta_m_slip", "kphi_prime ~ signed_slip"], "deferred": [],
+                           "rivals": [dict(drift, bic_vs_accepted=-3.0), dict(near, bic_vs_accepted=-9.0)]}]}
+    lines = verdict_lines(findings)
+    found = next(v for v in lines if v.startswith("found: sidewall"))
+    assert "cohesion ~ load" not in found and "varying with load in place of sidewall" in next(
+        v for v in lines if "generic drift fits about as well" in v)
+    assert not any("signed slip in place of theta_m_slip" in v for v in lines if "about as well" in v)
+    deferred = next(v for v in lines if v.startswith("deferred at step 1"))
+    assert "theta_m_slip" in deferred and "kphi_prime ~ signed_slip" in deferred
+    ambiguous = next(v for v in lines if v.startswith("ambiguous"))
+    assert "kphi_prime ~ signed_slip in place of theta_m_slip" in ambiguous and "-3.0" in ambiguous
+    assert "cohesion ~ load" not in ambiguous

@@ -35,8 +35,18 @@ there, instead of picking one. The best passing mechanism must also beat its **g
 angle, gravity, pass, load, wheel radius and width; :func:`~.extensions.drift_rivals`), fitted in its place, so an
 effect that follows a condition the mechanism does not act through (the load) is not read as the mechanism. A rival whose BIC is lower by more than
 :data:`RIVAL_MARGIN` explains the residual better with a form outside the catalogue ("some soil property changes
-with slip"): the mechanism is not named, the step reports an ambiguity between it and the rival, and selection
-stops. A weak effect of an unknown form otherwise takes the name of the nearest catalogue mechanism
+with slip"): the mechanism is not named at that step.
+
+An unresolved best mechanism is **deferred**, not the end of the search (:data:`~.selection.DEFER_UNRESOLVED`): the
+next passing candidate that shares no mechanism with a deferred group and is itself resolved is accepted in its
+place, and the deferred one is tried again at the next step, on a model that now holds the other; its rivals are
+fitted again there. A residual that two causes share can favour a drift while one of them is missing from the model
+(a grousered wheel's extra thrust, unmodelled, is partly absorbed by a pressure modulus drifting with the signed slip
+in place of ``theta_m_slip``). Where no passing single is resolved, each withheld mechanism is fitted in pairs with
+the other best singles (the look-ahead above, restricted to pairs that hold it; :meth:`_Search.withheld_pairs`): the
+missing cause may not pass alone when the withheld mechanism carries most of the residual, and in a pair the rivals
+are fitted with the partner in the model. Only when that finds no resolved pair either does the search stop, with
+the **ambiguity** reported. A weak effect of an unknown form otherwise takes the name of the nearest catalogue mechanism
 (docs/validation/campaigns.md: cohesion softening with slip named ``theta_m_slip``). What the final model still
 leaves systematic is reported as **unexplained**
 (:func:`~.residuals.unexplained_trends`), and an accepted mechanism that moves a response where a systematic
@@ -64,8 +74,8 @@ from .extensions import (BASELINE_FREE, BASELINE_OFF, EXTENSIONS, Extension, dri
                          varied_conditions)
 from .measured import Measurements
 from .residuals import CONDITIONS, residual_trends, systematic_residual, unexplained_trends
-from .selection import (AMBIGUITY_MARGIN, BIC_MARGIN, GAIN_SIGMAS, MIN_EXPLAINED, PAIR_POOL, RIVAL_MARGIN, Candidate,
-                        Discovery, Step)
+from .selection import (AMBIGUITY_MARGIN, BIC_MARGIN, DEFER_UNRESOLVED, GAIN_SIGMAS, MIN_EXPLAINED, PAIR_POOL,
+                        RIVAL_MARGIN, Candidate, Discovery, Step)
 from .terramechanics import SoilParameters
 
 __all__ = ["AMBIGUITY_MARGIN", "BIC_MARGIN", "CONDITIONS", "GAIN_SIGMAS", "MIN_EXPLAINED", "PAIR_POOL", "RESPONSES",
@@ -167,7 +177,7 @@ def _drift_rivals(train, current: Fit, free, best: Candidate, responses, scales)
             fit = calibrate(train, start, free + tuple(p for e in others for p in e.parameters) + rival.parameters,
                             responses=responses, scales=scales)
             out.append({"name": rival.name, "description": rival.mechanism, "replaces": member.name,
-                        "rate": fit.free["drift_rate"], "delta_bic": fit.bic - current.bic,
+                        "against": best.name, "rate": fit.free["drift_rate"], "delta_bic": fit.bic - current.bic,
                         "bic_vs_accepted": fit.bic - best.fit.bic})
     return sorted(out, key=lambda r: r["bic_vs_accepted"])
 
@@ -252,13 +262,17 @@ class _Search:
             passing = [c for c in step.candidates if c.passes]
         return step, passing
 
-    def _pair_step(self, singles: list, cur_err, cur_rmse) -> Step:
+    def _pair_step(self, singles: list, cur_err, cur_rmse, withheld: tuple[str, ...] = ()) -> Step:
         """Look-ahead: two mechanisms that act together can each fail alone; the best :data:`PAIR_POOL` singles are
-        fitted in pairs, each started from either member's own fit."""
+        fitted in pairs, each started from either member's own fit. ``withheld``: only the pairs holding one of
+        these mechanisms (:meth:`withheld_pairs`)."""
         by_name = {c.extension.name: c for c in singles}
         pool = [c.extension for c in singles[:PAIR_POOL]]
+        pool += [by_name[n].extension for n in withheld if by_name[n].extension not in pool]
         pairs = []
         for a, b in combinations(pool, 2):
+            if withheld and a.name not in withheld and b.name not in withheld:
+                continue
             fa, fb = by_name[a.name].fit, by_name[b.name].fit
             joint = self._fit((a, b), starts=[replace(fa.soil, **_mid(b)), replace(fb.soil, **_mid(a))])
             pairs.append(self.trial((a, b), joint, cur_err, cur_rmse,
@@ -268,12 +282,26 @@ class _Search:
         self.steps.append(step)
         return step
 
+    def withheld_pairs(self, step: Step, max_steps: int) -> tuple[Step, list] | None:
+        """Where every passing single of ``step`` is unresolved (:meth:`choose` found none to accept), each withheld
+        mechanism fitted in pairs with the other :data:`PAIR_POOL` best singles (:data:`DEFER_UNRESOLVED`): a cause
+        that is missing from the model can make a drift fit better than the mechanism, and then it may not pass
+        alone either (most of the residual is the mechanism's). None where the look-ahead does not apply."""
+        withheld = tuple(g[0] for g in [step.ambiguity] + step.deferred if g and " + " not in g[0])
+        if (not DEFER_UNRESOLVED or step.pairs or not withheld or len(self.names) + 2 > max_steps
+                or len(step.candidates) < 2 or not unexplained_trends(self.lack, [])):
+            return None
+        cur_err = self.heldout_error(self.current.soil)
+        pair_step = self._pair_step(step.candidates, cur_err, step.heldout_rmse, withheld)
+        return pair_step, [c for c in pair_step.candidates if c.passes]
+
     def unresolved(self, step: Step, best: Candidate, passing: list) -> list[str]:
-        """The rivals ``best`` does not beat: passing candidates within :data:`AMBIGUITY_MARGIN` that add nothing
-        joined to it, then (where none) the generic drifts that fit better by :data:`RIVAL_MARGIN`."""
+        """The rivals ``best`` does not beat: the other passing candidates within :data:`AMBIGUITY_MARGIN` of it that
+        add nothing joined to it, then (where none) the generic drifts that fit better by :data:`RIVAL_MARGIN` (added
+        to ``step.rivals``)."""
         unresolved = []
-        for rival in passing[1:]:
-            if rival.fit.bic - best.fit.bic >= AMBIGUITY_MARGIN:
+        for rival in passing:
+            if rival is best or abs(rival.fit.bic - best.fit.bic) >= AMBIGUITY_MARGIN:
                 continue
             if rival.partner is not None:  # two pairs about equally good
                 unresolved.append(rival.name)
@@ -282,9 +310,31 @@ class _Search:
             if joint.bic - best.fit.bic >= -BIC_MARGIN or _parameter_problems((rival.extension,), joint):
                 unresolved.append(rival.name)
         if not unresolved:
-            step.rivals = _drift_rivals(self.train, self.current, self.free, best, self.responses, self.scales)
-            unresolved = [r["name"] for r in step.rivals if r["bic_vs_accepted"] < -RIVAL_MARGIN]
+            rivals = _drift_rivals(self.train, self.current, self.free, best, self.responses, self.scales)
+            step.rivals = step.rivals + rivals
+            unresolved = [r["name"] for r in rivals if r["bic_vs_accepted"] < -RIVAL_MARGIN]
         return unresolved
+
+    def choose(self, step: Step, passing: list) -> Candidate | None:
+        """The passing candidate to accept: the best one its rivals do not beat (:meth:`unresolved`). With
+        :data:`DEFER_UNRESOLVED`, a better one that is unresolved is deferred (``step.deferred``) and the next one
+        sharing no mechanism with a deferred group is checked; otherwise (or where none is resolved) the first
+        unresolved group becomes ``step.ambiguity`` and None is returned: selection stops."""
+        held, taken = [], set()
+        for cand in passing:
+            if taken & set(cand.names):
+                continue
+            unresolved = self.unresolved(step, cand, passing)
+            if not unresolved:
+                step.deferred = held
+                return cand
+            held.append([cand.name] + unresolved)
+            taken |= {n for name in held[-1] for n in name.split(" + ") if n in EXTENSIONS}
+            if not DEFER_UNRESOLVED:
+                break
+        step.ambiguity = held[0]
+        step.deferred = held[1:]
+        return None
 
     def accept(self, step: Step, best: Candidate, remaining: list) -> None:
         best.accepted = True
@@ -320,12 +370,16 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
         step, passing = search.step(remaining, max_steps)
         if not passing:
             break
-        best = passing[0]
-        unresolved = search.unresolved(step, best, passing)
-        if unresolved:
-            step.ambiguity = [best.name] + unresolved
+        chosen = search.choose(step, passing)
+        if chosen is None and (ahead := search.withheld_pairs(step, max_steps)) is not None and ahead[1]:
+            singles_step, (step, passing) = step, ahead
+            chosen = search.choose(step, passing)
+            if chosen is not None:  # resolved in context: the singles' ambiguity was a deferral
+                singles_step.deferred = [singles_step.ambiguity] + singles_step.deferred
+                singles_step.ambiguity = []
+        if chosen is None:
             break
-        search.accept(step, best, remaining)
+        search.accept(step, chosen, remaining)
     current, steps = search.current, search.steps
     final_err = search.heldout_error(current.soil)
     _, final_trends = _lack_of_fit(current.soil, train, responses, scales)

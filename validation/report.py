@@ -46,7 +46,8 @@ def verdict_lines(findings: dict) -> list[str]:
         lines.append(f"found: {c['name']} ({params}; step {c['step'] + 1}, ΔBIC {c['delta_bic']:+.1f}, held-out gain "
                      f"{c['gain']:+.4f} ± {c['gain_std']:.4f}, removes {100 * c['explained']:.0f} % of the systematic "
                      f"residual) — {c['source']}")
-        close = [r for r in findings["steps"][c["step"]].get("rivals", []) if r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
+        close = [r for r in findings["steps"][c["step"]].get("rivals", [])
+                 if r.get("against", c["name"]) == c["name"] and r["bic_vs_accepted"] < AMBIGUITY_MARGIN]
         if close:
             lines.append("  but a generic drift fits about as well in its place: "
                          + "; ".join(f"{r['description']} in place of {r['replaces']} (ΔBIC {r['bic_vs_accepted']:+.1f} "
@@ -59,12 +60,17 @@ def verdict_lines(findings: dict) -> list[str]:
     if not findings["accepted"]:
         lines.append("found: nothing")
     for step in findings["steps"]:
+        for group in step.get("deferred", []):
+            lines.append(f"deferred at step {step['step'] + 1}: {group[0]} passes but does not beat "
+                         f"{' or '.join(group[1:])} on that model; it was tried again with another mechanism in the "
+                         "model (at the next step, or in a pair)")
         group = step["ambiguity"]
         if not group:
             continue
         rivals = {}
         for r in step.get("rivals", []):  # sorted best first: a drift fitted in place of two members keeps its best
-            rivals.setdefault(r["name"], r)
+            if r.get("against", group[0]) == group[0]:
+                rivals.setdefault(r["name"], r)
         generic = [rivals[n] for n in group if n in rivals]
         if generic:
             alternatives = "; ".join(f"{r['name']} in place of {r['replaces']}: {r['description']}, ΔBIC "
@@ -242,18 +248,20 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
                   "| mechanism | parameters | held-out gain | ΔBIC | removes | verdict |", "|---|---|---|---|---|---|"]
         for c in s["candidates"]:
             params = ", ".join(f"{k} = {v['value']:.3g}" for k, v in c["parameters"].items())
+            deferred = [g[0] for g in s.get("deferred", [])]
             verdict = ("**named**" if c["named"] else "accepted, partial" if c["accepted"] else "ambiguous" if c["name"] in s["ambiguity"]
-                       else "passes" if c["passes"] else "; ".join(c["why_not"]).replace("|", "\\|"))
+                       else "deferred" if c["name"] in deferred else "passes" if c["passes"] else "; ".join(c["why_not"]).replace("|", "\\|"))
             lines.append(f"| {c['name']} | {params} | {c['gain']:+.4f} ± {c['gain_std']:.4f} | {c['delta_bic']:+.1f} | "
                          f"{100 * c['explained']:.0f} % | {verdict} |")
         lines.append("")
         if s.get("rivals"):
-            lines += [("Generic rivals of the best mechanism (a classical parameter drifting linearly with a condition "
-                       f"the data vary, fitted in its place; one lower than the mechanism by more than {RIVAL_MARGIN:g} "
-                       "in the last column, and the mechanism is not named):"), "", "| rival | in place of | rate | ΔBIC | against the mechanism |",
-                      "|---|---|---|---|---|"]
-            lines += [f"| {r['description']} | {r['replaces']} | {r['rate']:+.3g} | {r['delta_bic']:+.1f} | "
-                      f"{r['bic_vs_accepted']:+.1f} |" for r in s["rivals"]] + [""]
+            lines += [("Generic rivals of each passing mechanism checked (a classical parameter drifting linearly with "
+                       f"a condition the data vary, fitted in its place; one lower than the mechanism by more than "
+                       f"{RIVAL_MARGIN:g} in the last column, and the mechanism is not named at this step):"), "",
+                      "| mechanism | rival | in place of | rate | ΔBIC | against the mechanism |",
+                      "|---|---|---|---|---|---|"]
+            lines += [f"| {r.get('against', '')} | {r['description']} | {r['replaces']} | {r['rate']:+.3g} | "
+                      f"{r['delta_bic']:+.1f} | {r['bic_vs_accepted']:+.1f} |" for r in s["rivals"]] + [""]
     if findings["steps"]:
         lines += ["![](candidates.png)", ""]
     if d.skipped:
