@@ -32,7 +32,9 @@ AMBIGUITY_MARGIN = 10.0
 RIVAL_MARGIN = 2.0
 #: An unresolved best mechanism (an ambiguity with another mechanism or a generic rival) is deferred, not the end of
 #: the search: the next passing candidate sharing no mechanism with it, if resolved, is accepted first and the
-#: deferred one tried again on that model (:meth:`.discovery._Search.choose`). Chosen on 2026-11-29 after `pair-93`,
+#: deferred one tried again on that model (:meth:`.discovery._Search.choose`); where no passing single is resolved,
+#: the withheld one is fitted in pairs with the best singles, its rivals refitted with the partner in the model
+#: (:meth:`.discovery._Search.withheld_pairs`). Chosen on 2026-11-29 after `pair-93`,
 #: where ``theta_m_slip`` beside an unmodelled ``grouser`` lost to a drift of k'phi with the signed slip and the
 #: search stopped with nothing named; judged on fresh seeds (docs/validation/campaigns.md).
 DEFER_UNRESOLVED = True
