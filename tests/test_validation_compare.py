@@ -217,3 +217,29 @@ def test_several_sweeps_are_one_model(tmp_path):
     with pytest.raises(WheelsoilInputError, match="'semi-empirical' is a model of its own"):
         simulated_runs([tmp_path / "a", "semi-empirical"])
 
+
+
+def test_an_error_of_one_wheel_shows_in_its_row_and_as_a_trend_with_the_wheel(tmp_path):
+    """Both wheels paired (the CMU rig's grousered and smooth wheels): an offset of the grousered wheel's drawbar pull
+    alone is that wheel's bias in the by-wheel table, none of the smooth one's, and a residual trend with the grouser
+    height (issue 34: trends with slip, steering angle and wheel)."""
+    from wheelsoil.validation.compare import write_comparison_report
+    from wheelsoil.validation.synthetic import synthetic_two_wheel_measurements
+
+    measured = synthetic_two_wheel_measurements({}, np.random.default_rng(2), cond=_cond())
+    sim = _as_sweep_summary(measured, tmp_path / "sweep")
+    grousered = sim.grouser_height > 0
+    sim.responses["drawbar_pull"] = sim.responses["drawbar_pull"] + np.where(grousered, 6.0, 0.0)
+    c = compare(measured, sim)
+    trend = next(t for t in c.trends if t["response"] == "drawbar_pull" and t["condition"] == "grouser_height")
+    assert trend["spearman"] > 0.85 and trend["p_value"] < 1e-6  # ranks: every grousered residual above the smooth
+    f = write_comparison_report(c, measured, sim, tmp_path / "report")
+    rows = {(g["by"], g["group"], g["response"]): g["simulation"] for g in f["residuals_by_group"]}
+    spread = f["responses"]["drawbar_pull"]["spread"]
+    height = f"{1e3 * measured.grouser_height.max():g} mm grousers"
+    assert rows[("wheel", height, "drawbar_pull")]["bias"] == pytest.approx(6.0 / spread, rel=1e-9)
+    assert rows[("wheel", "smooth", "drawbar_pull")]["bias"] == pytest.approx(0.0, abs=1e-12)
+    assert f"| {height} | drawbar_pull |" in (tmp_path / "report" / "report.md").read_text()
+    # one wheel: no wheel rows
+    one = compare(measured.select(~(measured.grouser_height > 0)), sim)
+    assert not any(t["condition"] == "grouser_height" for t in one.trends)

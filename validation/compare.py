@@ -25,8 +25,8 @@ from .report import UNITS
 #: Tolerances within which a measured and a simulated condition are the same test.
 MATCH = {"slip": ("abs", 0.01), "slip_angle": ("abs", 0.5), "load": ("rel", 0.01), "gravity": ("rel", 0.01),
          "passes": ("abs", 0.01), "radius": ("rel", 0.02), "width": ("rel", 0.02), "grouser_height": ("abs", 1e-4)}
-#: Conditions the residual trends are computed against.
-TREND_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes")
+#: Conditions the residual trends are computed against (the grouser height: the wheel, where both are paired).
+TREND_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height")
 #: Trend p-value below which a residual trend is reported as systematic.
 TREND_P = 0.01
 
@@ -153,7 +153,7 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
 
 def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, findings: dict) -> list[str]:
     """The residual (simulated - measured, over the response's measured spread) of the paired rows by kind of motion
-    (driving, braking, dragged) and by steering angle (:func:`~.residuals.residuals_by_group`); stored in
+    (driving, braking, dragged), by steering angle and by wheel (:func:`~.residuals.residuals_by_group`); stored in
     ``findings["residuals_by_group"]``."""
     from .residuals import group_table, residuals_by_group
 
@@ -164,7 +164,8 @@ def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, 
            for q, v in c.responses.items()}
     groups = residuals_by_group({"simulation": res}, paired)
     findings["residuals_by_group"] = groups
-    return ["", "By kind of motion and steering angle (residual over the measured spread; the trend is the residual's "
+    return ["", "By kind of motion, steering angle and wheel (residual over the measured spread; the trend is the "
+            "residual's "
             "rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
             *group_table(groups, ("simulation",), count="pairs")]
 

@@ -171,10 +171,10 @@ def plot_candidates(findings: dict, path: Path) -> None:
 
 
 def _group_lines(groups: list[dict]) -> list[str]:
-    """The report's table of residuals by kind of motion and by steering angle."""
+    """The report's table of residuals by kind of motion, by steering angle and (both wheels in the data) by wheel."""
     if not groups:
         return []
-    return ["### By kind of motion and steering angle", "",
+    return ["### By kind of motion, steering angle and wheel", "",
             "Every row (training and held out), residual normalised as above: mean (bias) and RMS, classical → final, "
             "and the final residual's rank correlation with slip inside the group (– with fewer than 4 rows).", "",
             *group_table(groups, ("classical", "final")), ""]

@@ -12,8 +12,8 @@ is systematic rather than noise.
   of the misfit a smooth function of the conditions would remove. A mechanism that is the cause of a misfit
   removes it; one that only resembles it leaves part of it (:mod:`.discovery` uses both).
 * :func:`residuals_by_group`: bias and RMS of each response's residual within each kind of motion (driving,
-  braking, dragged) and each steering angle, with the trend against slip inside the group, so an error that lives in
-  one branch is not averaged away by the others.
+  braking, dragged), each steering angle and, where the rows hold more than one, each wheel (by its grousers), with
+  the trend against slip inside the group, so an error that lives in one branch is not averaged away by the others.
 * :func:`unexplained_trends`: for each response whose lack of fit is significant, the conditions whose terms carry
   most of it (partial sums of squares), with their shares and the Spearman trend: "error trends with X".
 """
@@ -52,16 +52,20 @@ def residual_trends(residuals: dict[str, np.ndarray], data: Measurements, rows: 
 
 def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measurements) -> list[dict]:
     """Each model's residual per response within each row group: the kinds of motion
-    (:meth:`~.measured.Measurements.kinds`) and the steering angles (rounded to 0.1 deg).
+    (:meth:`~.measured.Measurements.kinds`), the steering angles (rounded to 0.1 deg) and, where the rows hold more
+    than one, the wheels (by grouser height: "smooth" or "<h> mm grousers").
 
     models: model name -> response -> residual over all rows (NaN where unmeasured). Returns one dict per (group,
     response): "by" ("motion" or "slip_angle"), "group", "response", "rows", and per model "bias", "rms" and
     "slip_spearman" (the residual's rank correlation with the heading slip inside the group; None with fewer than 4
-    rows, one slip or a constant residual)."""
+    rows, one slip or a constant residual). "by" is "motion", "slip_angle" or "wheel"."""
     out = []
     groups = [("motion", k, data.kinds() == k) for k in ("driving", "braking", "dragged")]
     angles = np.round(np.asarray(data.slip_angle, float), 1)
     groups += [("slip_angle", f"{a:g}", angles == a) for a in np.unique(angles)]
+    heights = np.round(1e3 * np.asarray(data.grouser_height, float), 2)  # [mm]
+    if np.unique(heights).size > 1:
+        groups += [("wheel", "smooth" if h == 0 else f"{h:g} mm grousers", heights == h) for h in np.unique(heights)]
     responses = next(iter(models.values())).keys() if models else ()
     for by, group, mask in groups:
         for q in responses:
@@ -91,7 +95,7 @@ def group_table(groups: list[dict], models: tuple[str, ...], *, count: str = "ro
     lines = [f"| group | response | {count} | bias{over} | RMS{over} | trend with slip |", "|---|---|---|---|---|---|"]
     for g in groups:
         rho = g[models[-1]]["slip_spearman"]
-        label = g["group"] if g["by"] == "motion" else f"{g['group']}°"
+        label = f"{g['group']}°" if g["by"] == "slip_angle" else g["group"]
         bias = " → ".join(f"{g[m]['bias']:+.3f}" for m in models)
         rms = " → ".join(f"{g[m]['rms']:.3f}" for m in models)
         lines.append(f"| {label} | {g['response']} | {g['rows']} | {bias} | {rms} | "
