@@ -27,5 +27,5 @@ start "wide-box calibration (issue 33)" "soillab_calibration.py run --design eps
   "$PY" docs/soillab_calibration.py run --design epsd-box --box 0.6 0.6 0.12 \
   --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface \
   --out docs/soillab/calibration-epsd-box --resume --cache "$RUNS/lab-cache"
-start "signed-slip campaigns (issue 36)" "validation/campaigns/signed-slip.sh" "$RUNS/signed-slip.out" \
+start "signed-slip campaigns (issue 36)" "validation/campaigns/signed-slip.sh|validation_campaign.py" "$RUNS/signed-slip.out" \
   bash docs/validation/campaigns/signed-slip.sh
