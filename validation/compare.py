@@ -165,8 +165,7 @@ def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, 
     groups = residuals_by_group({"simulation": res}, paired)
     findings["residuals_by_group"] = groups
     return ["", "By kind of motion, steering angle and wheel (residual over the measured spread; the trend is the "
-            "residual's "
-            "rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
+            "residual's rank correlation with slip inside the group, – with fewer than 4 pairs):", "",
             *group_table(groups, ("simulation",), count="pairs")]
 
 

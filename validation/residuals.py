@@ -56,9 +56,9 @@ def residuals_by_group(models: dict[str, dict[str, np.ndarray]], data: Measureme
     than one, the wheels (by grouser height: "smooth" or "<h> mm grousers").
 
     models: model name -> response -> residual over all rows (NaN where unmeasured). Returns one dict per (group,
-    response): "by" ("motion" or "slip_angle"), "group", "response", "rows", and per model "bias", "rms" and
-    "slip_spearman" (the residual's rank correlation with the heading slip inside the group; None with fewer than 4
-    rows, one slip or a constant residual). "by" is "motion", "slip_angle" or "wheel"."""
+    response): "by" ("motion", "slip_angle" or "wheel"), "group", "response", "rows", and per model "bias", "rms"
+    and "slip_spearman" (the residual's rank correlation with the heading slip inside the group; None with fewer than
+    4 rows, one slip or a constant residual)."""
     out = []
     groups = [("motion", k, data.kinds() == k) for k in ("driving", "braking", "dragged")]
     angles = np.round(np.asarray(data.slip_angle, float), 1)
