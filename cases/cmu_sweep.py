@@ -134,14 +134,20 @@ def trial_rows(folder: str | Path) -> list[dict]:
     return rows
 
 
+def _at(row: dict, wheel: str, angle: float, slip: float) -> bool:
+    """Whether a sweep row is the ``wheel``'s ("grouser", "smooth") at that steering angle [deg] and commanded slip
+    (within 0.05)."""
+    return (row["wheel.preset"] == f"cmu-k10-{wheel}" and row["test.slip_angle"] == angle
+            and abs(row["test.slip"] - slip) <= 0.05)
+
+
 def _pick(rows: list[dict], wheels: dict, slips: tuple) -> list[dict]:
     """Per wheel, steering angle and commanded slip of ``wheels`` x ``slips``, the first repeat's trial."""
     out = []
     for wheel, angles in wheels.items():
         for angle in angles:
             for slip in slips:
-                hits = [r for r in rows if r["wheel.preset"] == f"cmu-k10-{wheel}" and r["test.slip_angle"] == angle
-                        and abs(r["test.slip"] - slip) <= 0.05 and r["case.seed"] == SUBSET_TRIAL]
+                hits = [r for r in rows if _at(r, wheel, angle, slip) and r["case.seed"] == SUBSET_TRIAL]
                 if len(hits) != 1:
                     raise WheelsoilInputError(f"the {wheel} wheel at {angle:g} deg, slip {slip:g}, repeat "
                                               f"{SUBSET_TRIAL} matches {len(hits)} trials, not one")
@@ -159,8 +165,7 @@ def subset(rows: list[dict]) -> list[dict]:
 def replica_rows(rows: list[dict]) -> list[dict]:
     """The repeats other than the subset's of :data:`REPLICA_CONDITION`'s trial."""
     wheel, angle, slip = REPLICA_CONDITION
-    out = [r for r in rows if r["wheel.preset"] == f"cmu-k10-{wheel}" and r["test.slip_angle"] == angle
-           and abs(r["test.slip"] - slip) <= 0.05 and r["case.seed"] != SUBSET_TRIAL]
+    out = [r for r in rows if _at(r, wheel, angle, slip) and r["case.seed"] != SUBSET_TRIAL]
     if not out:
         raise WheelsoilInputError(f"the {wheel} wheel at {angle:g} deg, slip {slip:g} has no repeat but the subset's")
     return out
@@ -176,8 +181,7 @@ def longer_drives(rows: list[dict], longer: tuple) -> list[dict]:
     commanded slip within 0.05, drive [s]) with that ``test.drive_time``; each entry must name exactly one row."""
     out = []
     for wheel, angle, slip, drive in longer:
-        hits = [r for r in rows if r["wheel.preset"] == f"cmu-k10-{wheel}" and r["test.slip_angle"] == angle
-                and abs(r["test.slip"] - slip) <= 0.05]
+        hits = [r for r in rows if _at(r, wheel, angle, slip)]
         if len(hits) != 1:
             raise WheelsoilInputError(f"a longer drive of the {wheel} wheel at {angle:g} deg, slip {slip:g} matches "
                                       f"{len(hits)} rows of its sweep, not one")
