@@ -21,12 +21,14 @@ from wheelsoil.errors import WheelsoilInputError
 from .calibration import response_scales
 from .measured import Measurements
 from .report import UNITS
+from .residuals import CONDITIONS
 
 #: Tolerances within which a measured and a simulated condition are the same test.
 MATCH = {"slip": ("abs", 0.01), "slip_angle": ("abs", 0.5), "load": ("rel", 0.01), "gravity": ("rel", 0.01),
          "passes": ("abs", 0.01), "radius": ("rel", 0.02), "width": ("rel", 0.02), "grouser_height": ("abs", 1e-4)}
-#: Conditions the residual trends are computed against (the grouser height: the wheel, where both are paired).
-TREND_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height")
+#: Conditions the residual trends are computed against: those the workflow's own trends use (the grouser height is
+#: the wheel, where both are paired).
+TREND_CONDITIONS = CONDITIONS
 #: Trend p-value below which a residual trend is reported as systematic.
 TREND_P = 0.01
 
