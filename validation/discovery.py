@@ -256,11 +256,15 @@ class _Search:
         step = Step(len(self.steps), self.names, cur_rmse, self.lack["systematic"], singles)
         self.steps.append(step)
         passing = [c for c in singles if c.passes]
-        if (not passing and len(self.names) + 2 <= max_steps and len(singles) >= 2
-                and unexplained_trends(self.lack, [])):
+        if not passing and self._looks_ahead(singles, max_steps):
             step = self._pair_step(singles, cur_err, cur_rmse)
             passing = [c for c in step.candidates if c.passes]
         return step, passing
+
+    def _looks_ahead(self, singles: list, max_steps: int) -> bool:
+        """Whether pairs of ``singles`` may be fitted: room for two more mechanisms, two singles to pair, and a
+        significant systematic residual left."""
+        return len(self.names) + 2 <= max_steps and len(singles) >= 2 and bool(unexplained_trends(self.lack, []))
 
     def _pair_step(self, singles: list, cur_err, cur_rmse, withheld: tuple[str, ...] = ()) -> Step:
         """Look-ahead: two mechanisms that act together can each fail alone; the best :data:`PAIR_POOL` singles are
@@ -288,8 +292,7 @@ class _Search:
         that is missing from the model can make a drift fit better than the mechanism, and then it may not pass
         alone either (most of the residual is the mechanism's). None where the look-ahead does not apply."""
         withheld = tuple(g[0] for g in [step.ambiguity] + step.deferred if g and " + " not in g[0])
-        if (not DEFER_UNRESOLVED or step.pairs or not withheld or len(self.names) + 2 > max_steps
-                or len(step.candidates) < 2 or not unexplained_trends(self.lack, [])):
+        if not DEFER_UNRESOLVED or step.pairs or not withheld or not self._looks_ahead(step.candidates, max_steps):
             return None
         cur_err = self.heldout_error(self.current.soil)
         pair_step = self._pair_step(step.candidates, cur_err, step.heldout_rmse, withheld)
@@ -336,6 +339,20 @@ class _Search:
         step.deferred = held[1:]
         return None
 
+    def select(self, step: Step, passing: list, max_steps: int) -> tuple[Step, Candidate | None]:
+        """The step whose candidate is accepted and that candidate (None: the search stops on the step's ambiguity):
+        :meth:`choose` on ``step``, then, where it finds none, on the withheld mechanisms' pairs
+        (:meth:`withheld_pairs`); a pair resolved there turns the singles' ambiguity into a deferral."""
+        chosen = self.choose(step, passing)
+        if chosen is None and (ahead := self.withheld_pairs(step, max_steps)) is not None and ahead[1]:
+            pair_step, pair_passing = ahead
+            chosen = self.choose(pair_step, pair_passing)
+            if chosen is not None:  # resolved in context: the singles' ambiguity was a deferral
+                step.deferred = [step.ambiguity] + step.deferred
+                step.ambiguity = []
+            step = pair_step
+        return step, chosen
+
     def accept(self, step: Step, best: Candidate, remaining: list) -> None:
         best.accepted = True
         step.accepted = best.name
@@ -370,13 +387,7 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
         step, passing = search.step(remaining, max_steps)
         if not passing:
             break
-        chosen = search.choose(step, passing)
-        if chosen is None and (ahead := search.withheld_pairs(step, max_steps)) is not None and ahead[1]:
-            singles_step, (step, passing) = step, ahead
-            chosen = search.choose(step, passing)
-            if chosen is not None:  # resolved in context: the singles' ambiguity was a deferral
-                singles_step.deferred = [singles_step.ambiguity] + singles_step.deferred
-                singles_step.ambiguity = []
+        step, chosen = search.select(step, passing, max_steps)
         if chosen is None:
             break
         search.accept(step, chosen, remaining)

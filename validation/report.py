@@ -246,9 +246,9 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
         kind = " (pairs, look-ahead)" if s.get("pairs") else ""
         lines += [f"### Step {s['step'] + 1}{kind}: on {' + '.join(['classical'] + s['model'])}", "",
                   "| mechanism | parameters | held-out gain | ΔBIC | removes | verdict |", "|---|---|---|---|---|---|"]
+        deferred = [g[0] for g in s.get("deferred", [])]
         for c in s["candidates"]:
             params = ", ".join(f"{k} = {v['value']:.3g}" for k, v in c["parameters"].items())
-            deferred = [g[0] for g in s.get("deferred", [])]
             verdict = ("**named**" if c["named"] else "accepted, partial" if c["accepted"] else "ambiguous" if c["name"] in s["ambiguity"]
                        else "deferred" if c["name"] in deferred else "passes" if c["passes"] else "; ".join(c["why_not"]).replace("|", "\\|"))
             lines.append(f"| {c['name']} | {params} | {c['gain']:+.4f} ± {c['gain_std']:.4f} | {c['delta_bic']:+.1f} | "

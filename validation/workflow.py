@@ -260,9 +260,10 @@ def main_validate(args) -> int:
                   f"final model: {findings['final']['heldout_rmse']:.3f} (held out)")
     for s in findings["steps"]:
         console.print(f"step {s['step'] + 1} (on {' + '.join(['classical'] + s['model'])}):")
+        deferred = [g[0] for g in s.get("deferred", [])]
         for c in s["candidates"]:
             tag = ("  ACCEPTED" if c["accepted"] else "  ambiguous" if c["name"] in s["ambiguity"]
-                   else "  deferred" if any(c["name"] == g[0] for g in s.get("deferred", [])) else "")
+                   else "  deferred" if c["name"] in deferred else "")
             console.print(f"  {c['name']:18s} gain {c['gain']:+.4f} +- {c['gain_std']:.4f}  dBIC {c['delta_bic']:+8.1f}"
                           f"  removes {100 * c['explained']:3.0f} %{tag}")
     for line in verdict_lines(findings):
