@@ -43,18 +43,31 @@ class WarmStarts:
     evaluations start each wheel's solve from its last roots; :mod:`~wheelsoil.validation.sinkage_solve`)."""
 
     by_wheel: dict[tuple, SinkageWarmStart] = field(default_factory=dict)
+    #: The data's rows by wheel (:func:`wheel_rows`), found on the first call.
+    rows_by_wheel: list[tuple[np.ndarray, np.ndarray]] | None = None
 
     def for_wheel(self, key) -> SinkageWarmStart:
         return self.by_wheel.setdefault(tuple(float(v) for v in key), SinkageWarmStart())
 
 
+def wheel_rows(data: Measurements) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(radius, width, grouser height, grouser count) of each distinct wheel in ``data`` and the mask of its rows."""
+    wheels = np.stack([data.radius, data.width, data.grouser_height, data.grouser_count], axis=1)
+    return [(key, np.all(wheels == key, axis=1)) for key in np.unique(wheels, axis=0)]
+
+
 def model_responses(soil: SoilParameters, data: Measurements, warm: WarmStarts | None = None) -> dict[str, np.ndarray]:
     """The model's drawbar pull, lateral force, sinkage and torque at every measured condition (``warm``: start
-    the sinkage solves from the roots of the last call given the same object and data)."""
+    the sinkage solves from the roots of the last call given the same object and data, whose rows by wheel it
+    keeps)."""
     out = {q: np.full(len(data), np.nan) for q in RESPONSES}
-    wheels = np.stack([data.radius, data.width, data.grouser_height, data.grouser_count], axis=1)
-    for key in np.unique(wheels, axis=0):
-        rows = np.all(wheels == key, axis=1)
+    if warm is None:
+        groups = wheel_rows(data)
+    else:
+        if warm.rows_by_wheel is None:
+            warm.rows_by_wheel = wheel_rows(data)
+        groups = warm.rows_by_wheel
+    for key, rows in groups:
         wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
         pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
                        gravity=data.gravity[rows], passes=data.passes[rows], travel_slip=data.travel_slip[rows],

@@ -53,12 +53,14 @@ def _per_rim(displacement_rate, rim):
     wheel dragged sideways at 90 deg). The independent shear form is discontinuous there (an arbitrarily slow
     tangential slide at 89.99 deg already mobilises the full strength along x); the resultant form, which shares
     one strength along the slip velocity, is not."""
-    if np.all(rim > 0.0):  # the common case: every wheel turns
-        return displacement_rate / rim
-    rim = np.broadcast_to(rim, np.shape(displacement_rate))
     turning = rim > 0.0
-    sliding = np.where(displacement_rate == 0.0, 0.0, np.copysign(np.inf, displacement_rate))
-    return np.where(turning, displacement_rate / np.where(turning, rim, 1.0), sliding)
+    if np.all(turning):  # the common case: every wheel turns
+        return displacement_rate / rim
+    per_rim = displacement_rate / np.where(turning, rim, 1.0)
+    still = np.broadcast_to(~turning, per_rim.shape)  # the conditions' rows whose wheel does not turn
+    rate = np.broadcast_to(displacement_rate, per_rim.shape)[still]
+    per_rim[still] = np.where(rate == 0.0, 0.0, np.copysign(np.inf, rate))
+    return per_rim
 
 
 def janosi_hanamoto(strength, displacement, modulus):

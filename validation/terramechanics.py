@@ -57,7 +57,7 @@ from wheelsoil.gravity import EARTH_GRAVITY
 
 from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
-from .quadrature import QUADRATURE_POINTS, gauss_legendre, gauss_on
+from .quadrature import QUADRATURE_POINTS, gauss_legendre, graded_gauss_on
 from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
 from .sinkage_solve import SinkageWarmStart, solve_sinkage
@@ -305,20 +305,28 @@ def effective_radius(soil: SoilParameters, wheel: RigidWheel) -> float:
 
 
 def contact_points(theta_f, theta_m, theta_r):
-    """The contact's quadrature points (C conditions, Q points): theta [rad] and the weights on [theta_m, theta_f]
-    and [theta_r, theta_m], their sines and cosines (taken once: every integral of :func:`contact_forces` needs them),
-    and the cosine of the angle the normal stress is evaluated at: theta itself ahead of theta_m, and behind it the
-    angle mapped linearly onto [theta_m, theta_f] (Wong & Reece's rear region, seed 003 eq. 7)."""
-    x, w = gauss_legendre()
-    th_front, w_front = gauss_on(theta_m, theta_f, x, w)
-    th_rear, w_rear = gauss_on(theta_r, theta_m, x, w)
-    span = np.where(theta_m - theta_r > 0.0, theta_m - theta_r, 1.0)[:, None]
-    equivalent = theta_f[:, None] - (th_rear - theta_r[:, None]) / span * (theta_f - theta_m)[:, None]
+    """The contact's quadrature points (C conditions, 2Q points: the Q of [theta_m, theta_f], then the Q of
+    [theta_r, theta_m]): theta [rad], the weights, and their sines and cosines (taken once: every integral of
+    :func:`contact_forces` needs them). Each region's nodes cluster at its outer end, theta_f and theta_r, where the
+    stress vanishes as a power of the distance (:func:`.quadrature.graded_gauss_on`), with the same nodes in both:
+    the rear region's stress is evaluated at the angle mapped linearly onto [theta_m, theta_f] (Wong & Reece, seed 003
+    eq. 7), theta_f - (theta - theta_r) / (theta_m - theta_r) (theta_f - theta_m), which at a rear node is the front
+    node of the same rank, so the front points' stress serves both (:func:`normal_stress`)."""
+    th_front, w_front = graded_gauss_on(theta_f, theta_m)
+    th_rear, w_rear = graded_gauss_on(theta_r, theta_m)
     theta = np.concatenate([th_front, th_rear], axis=1)
     weight = np.concatenate([w_front, w_rear], axis=1)
-    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
-    cos_stress = np.concatenate([cos_theta[:, :th_front.shape[1]], np.cos(equivalent)], axis=1)
-    return theta, weight, sin_theta, cos_theta, cos_stress
+    return theta, weight, np.sin(theta), np.cos(theta)
+
+
+def normal_stress(k_pressure, n, theta_f, cos_theta):
+    """The normal stress sigma [Pa] at the contact points of :func:`contact_points` (``cos_theta`` their cosines):
+    k (cos theta_s - cos theta_f)^n (seed 003 eq. 7; ``k_pressure`` [Pa] and the exponent ``n`` per condition) at the
+    front points, theta_s = theta, and the same at the rear points of the same rank, whose mapped angle theta_s is
+    that front point's (:func:`contact_points`)."""
+    q = cos_theta.shape[1] // 2
+    front = k_pressure[:, None] * np.clip(cos_theta[:, :q] - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
+    return np.concatenate([front, front], axis=1)
 
 
 def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_angle, gravity,
@@ -365,8 +373,8 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
     shear_modulus = drifted("shear_modulus_x")  # k_y = k_x when k_x drifts (tied, as calibrated)
     shear_modulus_y = shear_modulus if soil.drift_field == "shear_modulus_x" else soil.shear_modulus_y
 
-    theta, weight, sin_theta, cos_theta, cos_stress = contact_points(theta_f, theta_m, theta_r)
-    sigma = k_pressure[:, None] * np.clip(cos_stress - np.cos(theta_f)[:, None], 0.0, None) ** n[:, None]
+    theta, weight, sin_theta, cos_theta = contact_points(theta_f, theta_m, theta_r)
+    sigma = normal_stress(k_pressure, n, theta_f, cos_theta)
     sigma = sigma + p_extra[:, None]  # seed 002 eq. 17 (0 unless an oscillating pressure is asked for)
 
     # seed 000 eq. 8: the soil under the rim moves with it, faster at lower gravity (sec. 3.3)
