@@ -27,14 +27,19 @@ from wheelsoil.errors import WheelsoilInputError
 
 from .extensions import BASELINE_FREE, Parameter
 from .measured import Measurements
+from .fit_jacobian import conditions_of, forward_steps, model_jacobian, wheel_of
 from .sinkage_solve import SinkageWarmStart
-from .terramechanics import RigidWheel, SoilParameters, predict
+from .terramechanics import SoilParameters, predict
 
 RESPONSES = ("drawbar_pull", "lateral_force", "sinkage", "torque")
 #: A parameter whose Fisher standard error exceeds this fraction of its fit range is reported unidentified.
 UNIDENTIFIED_RANGE_FRACTION = 0.25
 #: A bound binds when moving past it would lower the SSE by more than this many residual variances (2 sigma).
 BINDING_CHI2 = 4.0
+#: The fit's parameter step for the Jacobian, relative (scipy's ``diff_step``; :mod:`.fit_jacobian`).
+DIFF_STEP = 1e-4
+#: Every residual of a soil outside the model's domain (e.g. a1 + a2 > 1): a cost no fit accepts.
+OUTSIDE_RESIDUAL = 1e3
 
 
 @dataclass
@@ -56,22 +61,31 @@ def wheel_rows(data: Measurements) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(key, np.all(wheels == key, axis=1)) for key in np.unique(wheels, axis=0)]
 
 
-def model_responses(soil: SoilParameters, data: Measurements, warm: WarmStarts | None = None) -> dict[str, np.ndarray]:
-    """The model's drawbar pull, lateral force, sinkage and torque at every measured condition (``warm``: start
-    the sinkage solves from the roots of the last call given the same object and data, whose rows by wheel it
-    keeps)."""
-    out = {q: np.full(len(data), np.nan) for q in RESPONSES}
+def wheel_predictions(soil: SoilParameters, data: Measurements, warm: WarmStarts | None = None) -> list:
+    """:func:`~.terramechanics.predict` for each wheel of ``data``: (wheel key, row mask, prediction) per wheel
+    (``warm`` as :func:`model_responses`)."""
     if warm is None:
         groups = wheel_rows(data)
     else:
         if warm.rows_by_wheel is None:
             warm.rows_by_wheel = wheel_rows(data)
         groups = warm.rows_by_wheel
-    for key, rows in groups:
-        wheel = RigidWheel(radius=key[0], width=key[1], grouser_height=key[2], grouser_count=int(key[3]))
-        pred = predict(soil, wheel, slip=data.slip[rows], slip_angle=data.slip_angle[rows], load=data.load[rows],
-                       gravity=data.gravity[rows], passes=data.passes[rows], travel_slip=data.travel_slip[rows],
-                       warm_start=None if warm is None else warm.for_wheel(key))
+    return [(key, rows, predict(soil, wheel_of(key), **conditions_of(data, rows),
+                                warm_start=None if warm is None else warm.for_wheel(key)))
+            for key, rows in groups]
+
+
+def model_responses(soil: SoilParameters, data: Measurements, warm: WarmStarts | None = None) -> dict[str, np.ndarray]:
+    """The model's drawbar pull, lateral force, sinkage and torque at every measured condition (``warm``: start
+    the sinkage solves from the roots of the last call given the same object and data, whose rows by wheel it
+    keeps)."""
+    return responses_of(wheel_predictions(soil, data, warm), len(data))
+
+
+def responses_of(predictions: list, count: int) -> dict[str, np.ndarray]:
+    """The responses of :func:`wheel_predictions`' output by row (``count`` rows)."""
+    out = {q: np.full(count, np.nan) for q in RESPONSES}
+    for _, rows, pred in predictions:
         for q in RESPONSES:
             out[q][rows] = pred[q]
     return out
@@ -92,12 +106,18 @@ def response_scales(data: Measurements, responses) -> dict[str, float]:
 def normalised_residuals(soil, data, responses, scales, *, split: bool = False, warm: WarmStarts | None = None):
     """(model - measured) / scale over the measured values of each response, concatenated (or a dict by
     response with ``split``); ``warm`` as :func:`model_responses`."""
-    pred = model_responses(soil, data, warm)
+    return residuals_of(model_responses(soil, data, warm), data, responses, scales, split=split)
+
+
+def residuals_of(model: dict[str, np.ndarray], data: Measurements, responses, scales, *, split: bool = False):
+    """:func:`normalised_residuals` of the model's responses by row ``model``; a response's rows may carry a trailing
+    axis (its derivatives, which stack the same way: the Jacobian's rows)."""
     parts = {}
     for q in responses:
         y = data.responses[q]
         ok = np.isfinite(y)
-        parts[q] = (pred[q][ok] - y[ok]) / scales[q]
+        values = model[q][ok]
+        parts[q] = ((values - y[ok]) if values.ndim == 1 else values) / scales[q]
     if split:
         return parts
     return np.concatenate(list(parts.values())) if parts else np.zeros(0)
@@ -219,17 +239,36 @@ def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, 
         return replace(start, **values)
 
     warm = WarmStarts()  # each evaluation starts its sinkage solves from the last one's roots
+    last: dict = {}  # the last evaluation: its coordinates, the predictions by wheel (None outside the domain)
 
     def residual(x):
+        last["x"], last["predictions"] = np.array(x, float), None
         try:
-            return normalised_residuals(soil_of(x), data, responses, scales, warm=warm)
+            last["predictions"] = wheel_predictions(soil_of(x), data, warm)
         except WheelsoilInputError:  # a combination outside the model's domain (e.g. a1 + a2 > 1)
-            return np.full(n_res, 1e3)
+            return np.full(n_res, OUTSIDE_RESIDUAL)
+        return residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
+
+    def jacobian(x):
+        """Through the sinkage (:mod:`.fit_jacobian`), with scipy's two-point steps."""
+        x = np.asarray(x, float)
+        if "x" not in last or not np.array_equal(last["x"], x):
+            residual(x)
+        r0 = (residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
+              if last["predictions"] is not None else np.full(n_res, OUTSIDE_RESIDUAL))
+        steps = forward_steps(x, lo, hi, DIFF_STEP)
+        if last["predictions"] is None:  # outside the domain at x itself: plain forward differences
+            return np.stack([(residual(x + steps[k] * np.eye(x.size)[k]) - r0) / steps[k] for k in range(x.size)],
+                            axis=1)
+        derivative, invalid = model_jacobian(soil_of, x, steps, data, last["predictions"])
+        jac = residuals_of(derivative, data, responses, scales)
+        jac[:, invalid] = (OUTSIDE_RESIDUAL - r0[:, None]) / steps[invalid]  # what a difference would see
+        return jac
 
     n_res = normalised_residuals(start, data, responses, scales).size
     lo, hi = np.array([p.fit_bounds for p in free]).T
     x0 = np.clip([p.to_fit(getattr(start, p.name)) for p in free], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-    sol = least_squares(residual, x0, bounds=(lo, hi), x_scale="jac", max_nfev=max_evaluations, diff_step=1e-4)
+    sol = least_squares(residual, x0, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_evaluations)
     soil = soil_of(sol.x)
     return Fit(soil, {n: getattr(soil, n) for n in names}, residual(sol.x), bool(sol.success), sol.message,
                tuple(free), np.asarray(sol.jac, float))

@@ -62,9 +62,9 @@ from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tange
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
 from .sinkage_solve import SinkageWarmStart, solve_sinkage
 
-__all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "bearing_capacity_factors", "sidewall_force",
-           "side_bulldozing_force", "bulldozing_force", "grouser_forces", "janosi_hanamoto", "resultant_shear", "QUADRATURE_POINTS",
-           "gauss_legendre"]
+__all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "forces_at_sinkage", "bearing_capacity_factors",
+           "sidewall_force", "side_bulldozing_force", "bulldozing_force", "grouser_forces", "janosi_hanamoto",
+           "resultant_shear", "QUADRATURE_POINTS", "gauss_legendre"]
 
 
 #: How the shear stress is split between the heading and the axle (:class:`SoilParameters` ``shear_form``).
@@ -497,4 +497,17 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
     out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel, load=load)
     out["sinkage"] = z
     out["supported"] = supported
+    return {k: np.reshape(v, shape) for k, v in out.items()}
+
+
+def forces_at_sinkage(soil: SoilParameters, wheel: RigidWheel, sinkage, *, slip=None, slip_angle=0.0, load,
+                      gravity=EARTH_GRAVITY, passes=1.0, travel_slip=None) -> dict:
+    """The forces of :func:`predict` at a given ``sinkage`` [m] instead of the solved one (conditions as
+    :func:`predict`; the same numbers where ``sinkage`` is its root): with F_z(z) = W solved once, a parameter's
+    effect at fixed sinkage and the forces' slope with the sinkage give its whole effect through the sinkage it
+    moves (implicit differentiation; :func:`wheelsoil.validation.calibration.calibrate`'s Jacobian). Returns arrays
+    shaped like the broadcast inputs, the keys of :func:`contact_forces`."""
+    shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
+    z = np.broadcast_to(np.asarray(sinkage, float), shape).ravel()
+    out = contact_forces(soil, wheel, z, i, np.degrees(beta), g, passes=n_p, travel_slip=s_travel, load=load)
     return {k: np.reshape(v, shape) for k, v in out.items()}
