@@ -74,3 +74,18 @@ def test_a_step_outside_the_models_domain_is_flagged():
                                          cal.wheel_predictions(soil_of(x), data))
     assert invalid.tolist() == [j == k for j in range(x.size)]
     assert np.all(derivative["drawbar_pull"][:, k] == 0.0) and np.any(derivative["drawbar_pull"] != 0.0)
+
+
+def test_a_fit_lands_where_the_difference_jacobian_lands():
+    """The same fit with either Jacobian (the default through the sinkage, scipy's forward differences as before) ends
+    at the same SSE to 1e-6 and the same parameters to 1e-3; an unknown Jacobian is refused by name."""
+    data, scales, soil_of, x, lo, hi = _problem(7, "independent")
+    start = replace(syn.TRUE_SOIL, a1=0.2, n0=0.8, friction_angle=30.0, cohesion=100.0, kphi_prime=500.0, kc_prime=20.0)
+    fits = [cal.calibrate(data, start, BASELINE_FREE, responses=cal.RESPONSES, scales=scales, jacobian=j)
+            for j in cal.JACOBIANS]
+    assert all(f.success for f in fits)
+    assert fits[0].sse == pytest.approx(fits[1].sse, rel=1e-6)
+    for name, value in fits[1].free.items():
+        assert fits[0].free[name] == pytest.approx(value, rel=1e-3), name
+    with pytest.raises(WheelsoilInputError, match="jacobian = 'analytic'"):
+        cal.calibrate(data, start, BASELINE_FREE, responses=cal.RESPONSES, scales=scales, jacobian="analytic")

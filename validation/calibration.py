@@ -227,9 +227,17 @@ class Fit:
         return rows
 
 
+#: How a fit's Jacobian is formed: through the sinkage (:mod:`.fit_jacobian`, the default) or by scipy's forward
+#: differences of the whole prediction (as before 2026-11-29; kept to measure the two against each other).
+JACOBIANS = ("implicit", "difference")
+
+
 def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, ...], *, responses, scales,
-              max_evaluations: int = 400) -> Fit:
-    """Least-squares fit of ``free`` (bounded, log-transformed where marked) from ``start``."""
+              max_evaluations: int = 400, jacobian: str = "implicit") -> Fit:
+    """Least-squares fit of ``free`` (bounded, log-transformed where marked) from ``start``; ``jacobian`` one of
+    :data:`JACOBIANS`."""
+    if jacobian not in JACOBIANS:
+        raise WheelsoilInputError(f"jacobian = {jacobian!r}: allowed {list(JACOBIANS)}")
     names = [p.name for p in free]
 
     def soil_of(x):
@@ -249,7 +257,7 @@ def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, 
             return np.full(n_res, OUTSIDE_RESIDUAL)
         return residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
 
-    def jacobian(x):
+    def jacobian_through_sinkage(x):
         """Through the sinkage (:mod:`.fit_jacobian`), with scipy's two-point steps."""
         x = np.asarray(x, float)
         if "x" not in last or not np.array_equal(last["x"], x):
@@ -268,7 +276,9 @@ def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, 
     n_res = normalised_residuals(start, data, responses, scales).size
     lo, hi = np.array([p.fit_bounds for p in free]).T
     x0 = np.clip([p.to_fit(getattr(start, p.name)) for p in free], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-    sol = least_squares(residual, x0, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_evaluations)
+    jac = jacobian_through_sinkage if jacobian == "implicit" else "2-point"
+    sol = least_squares(residual, x0, jac=jac, bounds=(lo, hi), x_scale="jac", max_nfev=max_evaluations,
+                        diff_step=DIFF_STEP)
     soil = soil_of(sol.x)
     return Fit(soil, {n: getattr(soil, n) for n in names}, residual(sol.x), bool(sol.success), sol.message,
                tuple(free), np.asarray(sol.jac, float))
