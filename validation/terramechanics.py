@@ -59,7 +59,8 @@ from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, graded_gauss_on
 from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
-from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force, soil_state
+from .passive_forces import bulldozing_force, grouser_forces
+from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force
 from .sinkage_solve import SinkageWarmStart, solve_sinkage
 
 __all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "forces_at_sinkage", "bearing_capacity_factors",
@@ -421,49 +422,6 @@ def contact_forces(soil: SoilParameters, wheel: RigidWheel, sinkage, slip, slip_
         "theta_m": theta_m,
         "theta_r": theta_r,
     }
-
-
-def bulldozing_force(soil: SoilParameters, wheel: RigidWheel, sinkage, gravity, cohesion=None,
-                     density=None) -> np.ndarray:
-    """Bulldozing resistance of the soil pushed ahead of a wheel sunk by z [N] (magnitude, against travel).
-
-    Bekker's passive-pressure form as Wong (Theory of Ground Vehicles, ch. 2) and Ishigami et al. (2008)
-    give it, after Hegedus (1960; seed 002 ref. 7, named in seed 003 sec. 3.3.4)::
-
-        R_b = b (0.67 c z K_pc + 0.5 gamma z^2 K_pgamma)
-        K_pc = (N_c - tan phi) cos^2 phi,    K_pgamma = (2 N_gamma / tan phi + 1) cos^2 phi
-
-    with the modified Terzaghi factors of seed 003 eq. 18 (:func:`bearing_capacity_factors`) and gamma =
-    rho g. ``cohesion`` and ``density`` override the soil's (e.g. gravity-scaled or compacted) per condition.
-    """
-    z = np.asarray(sinkage, float)
-    phi = np.radians(soil.friction_angle)
-    n_gamma, n_c, _ = bearing_capacity_factors(soil.friction_angle)
-    k_pc = (n_c - np.tan(phi)) * np.cos(phi) ** 2
-    k_pgamma = (2.0 * n_gamma / np.tan(phi) + 1.0) * np.cos(phi) ** 2
-    rho, c = soil_state(soil, density, cohesion)
-    gamma = rho * np.asarray(gravity, float)
-    return wheel.width * (0.67 * c * z * k_pc + 0.5 * gamma * z * z * k_pgamma)
-
-
-def grouser_forces(soil: SoilParameters, wheel: RigidWheel, theta_f, theta_r, gravity, density=None, cohesion=None):
-    """Grouser forces (seed 003 eq. 20, surcharge q = 0): passive earth pressure on each grouser in the soil.
-
-    A grouser at angle theta carries F_g = b (rho g h^2 N_phi / 2 + 2 c h sqrt(N_phi)) normal to its radial
-    face, i.e. tangential to the wheel: forward thrust F_g cos theta and lift F_g sin theta, acting about
-    h / 3 inside the tip (seed 003: at about 2/3 of the grouser height), so the motor supplies
-    F_g (r + h / 3). Averaged over one grouser pitch, count / (2 pi) grousers per radian of contact arc.
-    ``density`` and ``cohesion`` override the soil's per condition. Returns (F_x, F_z, T) [N, N, N m].
-    """
-    h, b, r = wheel.grouser_height, wheel.width, wheel.radius
-    rho, c = soil_state(soil, density, cohesion)
-    n_phi = np.tan(np.pi / 4 + np.radians(soil.friction_angle) / 2) ** 2
-    per_grouser = b * (0.5 * rho * np.asarray(gravity, float) * h * h * n_phi + 2.0 * c * h * np.sqrt(n_phi))
-    per_radian = per_grouser * wheel.grouser_count / (2.0 * np.pi)
-    fx = per_radian * (np.sin(theta_f) - np.sin(theta_r))  # int cos(theta) d theta over the contact
-    fz = per_radian * (np.cos(theta_r) - np.cos(theta_f))  # int sin(theta) d theta
-    torque = per_radian * (theta_f - theta_r) * (r + h / 3.0)
-    return fx, fz, torque
 
 
 def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.0, load, gravity=EARTH_GRAVITY,
