@@ -9,8 +9,8 @@ of Numerical Integration*, 2nd ed., sec. 2.7.1): 48 nodes left relative errors u
 (other - end) s^k, s on [0, 1] (ibid., sec. 2.9.2, removing a singularity by a change of variable), which turns
 (theta - end)^n into s^(k(n+1) - 1) and lifts the order of convergence to about N^-(2k(n+1)). Measured in
 ``docs/validation/quadrature.md`` (``python docs/validation_quadrature.py``): with 24 nodes a region of power 2 the
-forces agree with a 400-node reference to 3.4e-10 (48 plain nodes: 1.4e-6) at about half the cost (0.44--0.75 in
-runs beside other jobs; a validation campaign's draw replayed 1.6 times faster). Braking rows are the exception for
+forces agree with a 400-node reference to 3.4e-10 (48 plain nodes: 1.4e-6), and a calibration runs 2.7 times faster
+(median of alternating rounds, ``python benchmarks/validation_fit.py``). Braking rows are the exception for
 every rule: their shear changes sign inside the contact, a kink in the independent form's integrand and a jump in
 the resultant form's, so errors there stay near 1e-5 relative (48 plain nodes: 3.0e-5), which is also how far two
 fine rules agree there.
@@ -28,7 +28,7 @@ QUADRATURE_POINTS = 48
 #: Nodes per contact region (front and rear of theta_m) of the graded rule (:func:`graded_gauss_on`), and the grading
 #: power k, chosen from ``docs/validation/quadrature.md``: four thousand times more accurate than the plain rule's 48
 #: nodes where the shear keeps its sign (sinkage exponents 0.5--2.2, both shear forms, driving, dragged and 90 deg
-#: rows), within the 1e-5 that braking rows allow any rule, at about half its cost.
+#: rows), within the 1e-5 that braking rows allow any rule, and a fit 2.7 times faster.
 CONTACT_POINTS = 24
 GRADING_POWER = 2
 
