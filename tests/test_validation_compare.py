@@ -243,3 +243,36 @@ def test_an_error_of_one_wheel_shows_in_its_row_and_as_a_trend_with_the_wheel(tm
     # one wheel: no wheel rows
     one = compare(measured.select(~(measured.grouser_height > 0)), sim)
     assert not any(t["condition"] == "grouser_height" for t in one.trends)
+
+
+def test_the_rigs_repeats_stand_beside_the_simulations_replicas(tmp_path):
+    """Three repeats of one test at their own loads (as the CMU rig's), each twinned by its own run, and a fourth
+    trial at another slip: the repeats' table holds the standard deviation (ddof 1) of the measured means and of the
+    simulated ones over those three, and nothing for the single trial; without repeats the report says the
+    run-to-run spread is not measured."""
+    from dataclasses import replace as dc_replace
+
+    from wheelsoil.validation.compare import repeat_spreads, write_comparison_report
+
+    base = synthetic_measurements({}, np.random.default_rng(1), cond=_cond())
+    first = 0
+    other = int(np.flatnonzero((base.slip != base.slip[first]) & (base.slip_angle == base.slip_angle[first]))[0])
+    m = base.select(np.array([first, first, first, other]))  # three repeats of one test, and a test at another slip
+    m = dc_replace(m, load=np.array([60.0, 61.5, 58.7, 60.0]), name="rig")
+    m.responses["drawbar_pull"] = np.array([2.0, 3.0, 4.5, 9.0])
+    sim = _as_sweep_summary(m, tmp_path / "sweep")
+    sim.responses["drawbar_pull"] = np.array([8.0, 8.5, 10.0, 12.0])
+    c = compare(m, sim)
+    groups = repeat_spreads(c, m, sim)
+    assert len(groups) == 1 and groups[0]["repeats"] == 3
+    dp = groups[0]["spreads"]["drawbar_pull"]
+    assert dp["measured"] == pytest.approx(np.std([2.0, 3.0, 4.5], ddof=1), rel=1e-12)
+    assert dp["simulated"] == pytest.approx(np.std([8.0, 8.5, 10.0], ddof=1), rel=1e-12)
+    findings = write_comparison_report(c, m, sim, tmp_path / "report")
+    assert findings["repeats"] == groups
+    assert "| 3 | drawbar_pull |" in (tmp_path / "report" / "report.md").read_text()
+    single = m.select(np.array([0, 3]))
+    c1 = compare(single, sim)
+    assert repeat_spreads(c1, single, sim) == []
+    write_comparison_report(c1, single, sim, tmp_path / "one")
+    assert "run-to-run spread is not measured here" in (tmp_path / "one" / "report.md").read_text()

@@ -8,7 +8,9 @@ listed, not guessed. For each response the report gives the paired values, the r
 measured, its size in combined standard deviations (the measured and the simulated scatter, where known),
 the bias and RMS error normalised by the measured spread (over every measured row), and the Spearman trend of the residual against
 each condition that varies: the same diagnostics the semi-empirical model gets, so a systematic error of
-the simulation (e.g. growing with the steering angle) is named the same way.
+the simulation (e.g. growing with the steering angle) is named the same way. Where a test was repeated (a rig's
+repeats, each at its own measured load) and every repeat has its own run (replicas: other seeds), the spread of
+the measured means and of the simulated ones stand side by side (:func:`repeat_spreads`).
 """
 
 from dataclasses import dataclass
@@ -54,12 +56,15 @@ class Comparison:
         return [t for t in self.trends if t["p_value"] < TREND_P]
 
 
-def same_conditions(ref: Measurements, other: Measurements, j: int) -> np.ndarray:
-    """The rows of ``ref`` at the conditions of row ``j`` of ``other``: every :data:`MATCH` key within its tolerance,
-    and the travel slip (the rig's) within the slip's where both sets give it. At 90 deg the heading slip is +-1
-    whatever the wheel's speed (``wheelsoil.slip``), so there only the travel slip tells one slip from another."""
+def same_conditions(ref: Measurements, other: Measurements, j: int, ignore: tuple[str, ...] = ()) -> np.ndarray:
+    """The rows of ``ref`` at the conditions of row ``j`` of ``other``: every :data:`MATCH` key within its tolerance
+    (those in ``ignore`` aside), and the travel slip (the rig's) within the slip's where both sets give it. At 90 deg
+    the heading slip is +-1 whatever the wheel's speed (``wheelsoil.slip``), so there only the travel slip tells one
+    slip from another."""
     ok = np.ones(len(ref), bool)
     for key in MATCH:
+        if key in ignore:
+            continue
         ok &= _same(key, np.asarray(getattr(ref, key), float), float(getattr(other, key)[j]))
     if ref.travel_slip is not None and other.travel_slip is not None:
         ok &= np.abs(np.asarray(ref.travel_slip, float) - float(other.travel_slip[j])) <= MATCH["slip"][1]
@@ -153,6 +158,60 @@ def compare(data: Measurements, simulated: Measurements, responses=None) -> Comp
     return Comparison(pairs, unmatched, stats, trends)
 
 
+#: What may differ between a rig's repeats of one test: each repeat is run at its own measured load.
+REPEAT_FREE = ("load",)
+
+
+def repeat_spreads(c: Comparison, data: Measurements, simulated: Measurements) -> list[dict]:
+    """The rig's repeats beside the simulation's replicas: measured rows paired in ``c`` that are the same test
+    (:func:`same_conditions`, :data:`REPEAT_FREE` aside), two or more of them, each paired with its own run. For each
+    such test and response, the standard deviation (ddof 1) of the measured means over the repeats and of the
+    simulated means over their runs (the replicas: other seeds, each at its repeat's load), [response units]."""
+    pairs = c.pairs
+    left = list(range(len(pairs)))
+    groups = []
+    while left:
+        first = left[0]
+        same = same_conditions(data.select(pairs[left, 0]), data, int(pairs[first, 0]), ignore=REPEAT_FREE)
+        members = [k for k, hit in zip(left, same) if hit]
+        left = [k for k in left if k not in members]
+        runs = pairs[members, 1]
+        if len(members) < 2 or len(set(runs.tolist())) < len(members):
+            continue
+        rows = pairs[members, 0]
+        spreads = {}
+        for q in c.responses:
+            y, s = data.responses[q][rows], simulated.responses[q][runs]
+            ok = np.isfinite(y) & np.isfinite(s)
+            if ok.sum() >= 2:
+                spreads[q] = {"measured": float(np.std(y[ok], ddof=1)), "simulated": float(np.std(s[ok], ddof=1)),
+                              "n": int(ok.sum())}
+        groups.append({"slip_angle": float(data.slip_angle[rows[0]]), "travel_slip": float(data.travel_slip[rows[0]]),
+                       "grouser_height": float(data.grouser_height[rows[0]]), "repeats": len(members),
+                       "loads": [float(v) for v in data.load[rows]], "spreads": spreads})
+    return groups
+
+
+def _repeat_lines(c: Comparison, data: Measurements, simulated: Measurements, findings: dict) -> list[str]:
+    """The report's table of :func:`repeat_spreads` (stored in ``findings["repeats"]``)."""
+    groups = repeat_spreads(c, data, simulated)
+    findings["repeats"] = groups
+    if not groups:
+        return ["", "No measured test is paired more than once (no repeats each with its own run): the simulation's "
+                "run-to-run spread is not measured here."]
+    lines = ["", "Repeats: measured rows of one test (each at its own load) paired each with its own run, so the rig's "
+             "repeat-to-repeat spread of the means stands beside the simulation's run-to-run spread (replicas: other "
+             "seeds). Standard deviations (ddof 1) of the means:", "",
+             "| test | repeats | response | rig's repeats | simulation's runs |", "|---|---|---|---|---|"]
+    for g in groups:
+        wheel = "smooth" if g["grouser_height"] == 0 else f"{1e3 * g['grouser_height']:g} mm grousers"
+        test = f"{wheel}, {g['slip_angle']:g}°, travel slip {g['travel_slip']:+.2f}"
+        for q, v in g["spreads"].items():
+            unit, k = UNITS[q]
+            lines.append(f"| {test} | {v['n']} | {q} | {k * v['measured']:.3g} {unit} | {k * v['simulated']:.3g} {unit} |")
+    return lines
+
+
 def _by_group_lines(c: Comparison, data: Measurements, simulated: Measurements, findings: dict) -> list[str]:
     """The residual (simulated - measured, over the response's measured spread) of the paired rows by kind of motion
     (driving, braking, dragged), by steering angle and by wheel (:func:`~.residuals.residuals_by_group`); stored in
@@ -224,6 +283,7 @@ def write_comparison_report(c: Comparison, data: Measurements, simulated: Measur
     else:
         lines += ["", f"No residual trend reaches p < {TREND_P:g}."]
     lines += _by_group_lines(c, data, simulated, findings)
+    lines += _repeat_lines(c, data, simulated, findings)
     lines += ["", "![measured vs simulated](measured_vs_simulated.png)"]
     findings["report"] = str(write_markdown_and_json(out / "report.md", "\n".join(lines) + "\n",
                                                      out / "findings.json", findings))
