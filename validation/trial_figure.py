@@ -67,7 +67,45 @@ def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *,
                 ax.set_ylabel(f"{q.replace('_', ' ')} [N]")
     axes[0, 0].legend(fontsize=6)
     fig.tight_layout()
+    for row, q in enumerate(responses):
+        _frame_on_data(axes[row], data, q, lines, points or {}, slip, angles)
     path = Path(path)
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def frame_limits(data: Measurements, q: str, points: dict) -> tuple[float, float] | None:
+    """The y range of response ``q``'s panels: the measured points with their error bars and the models' points, 10 %
+    beyond (None where there is nothing finite)."""
+    std = np.nan_to_num(data.std.get(q, np.zeros(len(data))))
+    values = [data.responses[q] - std, data.responses[q] + std]
+    for p in points.values():
+        err = np.nan_to_num(p.std[q]) if q in p.std else 0.0
+        values += [p.responses[q] - err, p.responses[q] + err]
+    values = np.concatenate([np.ravel(v) for v in values])
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return None
+    lo, hi = float(values.min()), float(values.max())
+    pad = 0.1 * max(hi - lo, 1e-9)
+    return lo - pad, hi + pad
+
+
+def _frame_on_data(row_axes, data: Measurements, q: str, lines: dict, points: dict, slip, angles) -> None:
+    """Scale one row of panels (one response, shared y) to :func:`frame_limits`; a model line that leaves the frame
+    (e.g. a model that cannot carry the load sinks to its deepest and drags hundreds of newtons) is clipped, and its
+    panel says how far it goes."""
+    limits = frame_limits(data, q, points)
+    if limits is None:
+        return
+    lo, hi = limits
+    row_axes[0].set_ylim(lo, hi)
+    for ax, beta in zip(row_axes, angles):
+        m = data.slip_angle == beta
+        model = np.concatenate([np.asarray(pred[q], float)[m] for pred in lines.values()]) if lines else np.zeros(0)
+        model = model[np.isfinite(model)]
+        if model.size and (model.min() < lo or model.max() > hi):
+            far = model.min() if model.min() < lo else model.max()
+            ax.text(0.03, 0.93, f"a model line leaves the frame (to {far:.0f} N)",
+                    transform=ax.transAxes, fontsize=6, color="0.3")
