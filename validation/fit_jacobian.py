@@ -25,7 +25,7 @@ import numpy as np
 from wheelsoil.errors import WheelsoilInputError
 
 from .measured import Measurements
-from .terramechanics import RigidWheel, SoilParameters, forces_at_sinkage
+from .terramechanics import CheckedConditions, RigidWheel, SoilParameters, forces_at_sinkage
 
 #: The model's responses with a force's form (the sinkage is the fourth, :data:`.calibration.RESPONSES`).
 FORCES = ("drawbar_pull", "lateral_force", "torque")
@@ -72,18 +72,18 @@ def model_jacobian(soil_of: Callable[[np.ndarray], SoilParameters], x: np.ndarra
             stepped.append(None)
             invalid[k] = True
     for key, rows, pred in predictions:
-        wheel, cond = wheel_of(key), conditions_of(data, rows)
+        wheel, cond = wheel_of(key), CheckedConditions.of(**conditions_of(data, rows))  # checked once for all
         z = np.asarray(pred["sinkage"], float)
         supported = np.asarray(pred["supported"], bool)
         dz = SINKAGE_STEP * z
-        deeper = forces_at_sinkage(soil, wheel, z + dz, **cond)
+        deeper = forces_at_sinkage(soil, wheel, z + dz, cond)
         slope_fz = (deeper["vertical_force"] - pred["vertical_force"]) / dz
         slope = {q: (deeper[q] - pred[q]) / dz for q in FORCES}
         for k, soil_k in enumerate(stepped):
             if soil_k is None:
                 continue
             try:
-                moved = forces_at_sinkage(soil_k, wheel, z, **cond)
+                moved = forces_at_sinkage(soil_k, wheel, z, cond)
             except WheelsoilInputError:
                 invalid[k] = True
                 continue

@@ -63,9 +63,9 @@ from .passive_forces import bulldozing_force, grouser_forces
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force
 from .sinkage_solve import SinkageWarmStart, solve_sinkage
 
-__all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "forces_at_sinkage", "bearing_capacity_factors",
-           "sidewall_force", "side_bulldozing_force", "bulldozing_force", "grouser_forces", "janosi_hanamoto",
-           "resultant_shear", "QUADRATURE_POINTS", "gauss_legendre"]
+__all__ = ["SoilParameters", "RigidWheel", "contact_forces", "predict", "CheckedConditions", "forces_at_sinkage",
+           "bearing_capacity_factors", "sidewall_force", "side_bulldozing_force", "bulldozing_force", "grouser_forces",
+           "janosi_hanamoto", "resultant_shear", "QUADRATURE_POINTS", "gauss_legendre"]
 
 
 #: How the shear stress is split between the heading and the axle (:class:`SoilParameters` ``shear_form``).
@@ -458,14 +458,37 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
     return {k: np.reshape(v, shape) for k, v in out.items()}
 
 
-def forces_at_sinkage(soil: SoilParameters, wheel: RigidWheel, sinkage, *, slip=None, slip_angle=0.0, load,
-                      gravity=EARTH_GRAVITY, passes=1.0, travel_slip=None) -> dict:
-    """The forces of :func:`predict` at a given ``sinkage`` [m] instead of the solved one (conditions as
-    :func:`predict`; the same numbers where ``sinkage`` is its root): with F_z(z) = W solved once, a parameter's
-    effect at fixed sinkage and the forces' slope with the sinkage give its whole effect through the sinkage it
-    moves (implicit differentiation; :func:`wheelsoil.validation.calibration.calibrate`'s Jacobian). Returns arrays
-    shaped like the broadcast inputs, the keys of :func:`contact_forces`."""
-    shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
-    z = np.broadcast_to(np.asarray(sinkage, float), shape).ravel()
-    out = contact_forces(soil, wheel, z, i, np.degrees(beta), g, passes=n_p, travel_slip=s_travel, load=load)
-    return {k: np.reshape(v, shape) for k, v in out.items()}
+@dataclass(frozen=True)
+class CheckedConditions:
+    """Test conditions as :func:`predict` takes them, broadcast, checked and in its internal form, made once
+    (:meth:`of`) for several force evaluations at them (:func:`forces_at_sinkage`): ``shape`` of the broadcast
+    inputs; per row (flattened): slip along the heading, steering angle [deg], load [N], gravity [m/s^2], pass number
+    and the travel slip."""
+
+    shape: tuple
+    slip: np.ndarray
+    slip_angle: np.ndarray
+    load: np.ndarray
+    gravity: np.ndarray
+    passes: np.ndarray
+    travel_slip: np.ndarray
+
+    @classmethod
+    def of(cls, *, slip=None, slip_angle=0.0, load, gravity=EARTH_GRAVITY, passes=1.0,
+           travel_slip=None) -> "CheckedConditions":
+        shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
+        return cls(shape, i, np.degrees(beta), load, g, n_p, s_travel)
+
+
+def forces_at_sinkage(soil: SoilParameters, wheel: RigidWheel, sinkage, conditions: CheckedConditions) -> dict:
+    """The forces of :func:`predict` at a given ``sinkage`` [m] instead of the solved one, at ``conditions``
+    (:meth:`CheckedConditions.of`, with :func:`predict`'s arguments; the same numbers where ``sinkage`` is its
+    root): with F_z(z) = W solved once, a parameter's effect at fixed sinkage and the forces' slope with the sinkage
+    give its whole effect through the sinkage it moves (implicit differentiation;
+    :func:`wheelsoil.validation.calibration.calibrate`'s Jacobian). Returns arrays shaped like the conditions, the keys
+    of :func:`contact_forces`."""
+    c = conditions
+    z = np.broadcast_to(np.asarray(sinkage, float), c.shape).ravel()
+    out = contact_forces(soil, wheel, z, c.slip, c.slip_angle, c.gravity, passes=c.passes, travel_slip=c.travel_slip,
+                         load=c.load)
+    return {k: np.reshape(v, c.shape) for k, v in out.items()}
