@@ -26,8 +26,8 @@ from scipy.optimize import least_squares
 from wheelsoil.errors import WheelsoilInputError
 
 from .extensions import BASELINE_FREE, Parameter
-from .measured import Measurements
 from .fit_jacobian import conditions_of, forward_steps, model_jacobian, wheel_of
+from .measured import Measurements
 from .sinkage_solve import SinkageWarmStart
 from .terramechanics import SoilParameters, predict
 

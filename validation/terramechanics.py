@@ -57,9 +57,9 @@ from wheelsoil.gravity import EARTH_GRAVITY
 
 from wheelsoil.slip import heading_slip_from_travel, travel_slip_from_heading
 
+from .passive_forces import bulldozing_force, grouser_forces
 from .quadrature import QUADRATURE_POINTS, gauss_legendre, graded_gauss_on
 from .shear import janosi_hanamoto, lateral_displacement, resultant_shear, tangential_displacement, wheel_speeds
-from .passive_forces import bulldozing_force, grouser_forces
 from .side_forces import bearing_capacity_factors, side_bulldozing_force, sidewall_force
 from .sinkage_solve import SinkageWarmStart, solve_sinkage
 
