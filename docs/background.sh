@@ -3,6 +3,7 @@
 # starts those not running, with the settings they share the machine's two cores under. Run it from the repository
 # root at the start of a session (a fresh machine keeps the repository, not RUNS):
 #   bash docs/background.sh [RUNS]        # RUNS: the runs folder outside the repository (default /work/runs)
+#   python docs/background_status.py --runs RUNS   # where each stands (reads files only)
 # Each job keeps what it finished (the twin's records in docs/cmu-twin/runs, the calibration's candidates in
 # docs/soillab/calibration-epsd-box/candidates, the campaigns' draws in docs/validation/campaigns/*.jsonl); a job
 # already running is left alone. The twin and the calibration get one Taichi thread each (two runs on two cores step

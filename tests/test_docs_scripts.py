@@ -359,3 +359,25 @@ def test_the_force_balance_table_averages_each_term_over_the_steady_window(tmp_p
     row = table.balance(tmp_path / "run")
     assert row["vertical_force_applied"] == pytest.approx(0.625) and row["weight"] == pytest.approx(0.625)
     assert row["largest_residual"] == 1.0 and row["steady"] and row["load"] == 80.0
+
+
+def test_the_background_status_reads_the_queue_log_and_the_campaign_list(tmp_path):
+    """The status screen names the twin queue's last start and end from its log, each checkpoint's simulated time,
+    and every campaign the runner script lists with its target number of draws."""
+    import h5py
+
+    status = _load("background_status")
+    (tmp_path / "cmu_queue.log").write_text("08:00:00 start sweep-a 1111\n09:00:00 end sweep-a 1111: ok in 3600 s\n"
+                                            "09:00:01 start sweep-b 2222\nsome traceback line\n")
+    case = tmp_path / "sweep-b" / "cases" / "2222"
+    case.mkdir(parents=True)
+    with h5py.File(case / ".checkpoint.h5", "w") as h5:
+        h5.attrs["t"] = 3.25
+    lines = status.twin_lines(tmp_path)
+    assert lines[1].startswith("  09:00:00 end sweep-a") and lines[2].startswith("  09:00:01 start sweep-b")
+    assert "sweep-b/2222: t = 3.25 s simulated" in lines[3]
+    import re
+
+    script = status.CAMPAIGN_SCRIPT.read_text()
+    listed = [re.match(r"  (\w+)-(\d+): \d+ of (\d+) draws", ln) for ln in status.campaign_lines()[1:]]
+    assert listed and all(m and f'"{m[1]} {m[3]} {m[2]}"' in script for m in listed)

@@ -1,0 +1,86 @@
+"""Where the long background campaigns stand (issues 33, 34, 36; ``docs/background.sh`` starts them): one screen.
+
+* the CMU twin's queue (``docs/cmu-twin/queue.json``): its last start and end in ``RUNS/cmu_queue.log``, and for each
+  case that has a checkpoint under ``RUNS/*/cases`` its simulated time and when it was written;
+* the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective;
+* the validation campaigns that ``docs/validation/campaigns/signed-slip.sh`` runs: the draws each has of its target.
+
+Reads files only (it starts and stops nothing), so it can run beside the jobs::
+
+    python docs/background_status.py [--runs RUNS]
+"""
+
+import argparse
+import json
+import os
+import re
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "signed-slip.sh"
+CALIBRATION = ROOT / "docs" / "soillab" / "calibration-epsd-box" / "candidates"
+#: Candidates in the wide-box design (the nine grid points and the earlier surface minimum, docs/soillab/README.md).
+CALIBRATION_CANDIDATES = 10
+
+
+def twin_lines(runs: Path) -> list[str]:
+    """The queue's last start/end lines and every checkpoint's simulated time."""
+    lines = ["CMU twin queue (issue 34):"]
+    log = runs / "cmu_queue.log"
+    if log.is_file():
+        events = [ln.strip() for ln in log.read_text().splitlines() if re.match(r"\d\d:\d\d:\d\d (start|end) ", ln)]
+        lines += [f"  {ln[:150]}" for ln in events[-2:]] or ["  (no case started yet)"]
+    else:
+        lines.append(f"  no log at {log}")
+    for path in sorted(runs.glob("*/cases/*/.checkpoint.h5")):
+        import h5py
+
+        with h5py.File(path, "r") as h5:
+            t = float(h5.attrs.get("t", float("nan")))
+        written = time.strftime("%Y-%m-%d %H:%M", time.localtime(os.path.getmtime(path)))
+        lines.append(f"  running {path.parts[-4]}/{path.parts[-2]}: t = {t:.2f} s simulated (checkpoint {written})")
+    queue = ROOT / "docs" / "cmu-twin" / "queue.json"
+    if queue.is_file():
+        lines.append(f"  queue: {len(json.loads(queue.read_text()))} entries in {queue.relative_to(ROOT)}")
+    return lines
+
+
+def calibration_lines() -> list[str]:
+    """The finished wide-box candidates and the least objective among them."""
+    done = []
+    for path in sorted(CALIBRATION.glob("*.json")):
+        record = json.loads(path.read_text())
+        objective = record.get("objective")
+        done.append((float(objective) if objective is not None else float("inf"), path.stem))
+    lines = [f"wide-box calibration (issue 33): {len(done)} of {CALIBRATION_CANDIDATES} candidates"]
+    if done:
+        best = min(done)
+        lines.append(f"  least objective so far: {best[1]} ({best[0]:.3f})")
+    return lines
+
+
+def campaign_lines() -> list[str]:
+    """Each campaign of the runner script with its draws done of its target."""
+    text = CAMPAIGN_SCRIPT.read_text() if CAMPAIGN_SCRIPT.is_file() else ""
+    match = re.search(r'for spec in ((?:"[^"]+" ?)+); do', text)
+    lines = ["validation campaigns (issue 36):"]
+    if not match:
+        return lines + [f"  no campaign list found in {CAMPAIGN_SCRIPT}"]
+    for spec in re.findall(r'"([^"]+)"', match.group(1)):
+        kind, draws, seed = spec.split()
+        path = CAMPAIGN_SCRIPT.parent / f"{kind}-{seed}.jsonl"
+        done = sum(1 for ln in path.read_text().splitlines() if ln.strip()) if path.is_file() else 0
+        lines.append(f"  {kind}-{seed}: {done} of {draws} draws")
+    return lines
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=Path, default=Path("/work/runs"), help="the runs folder (default /work/runs)")
+    args = ap.parse_args(argv)
+    print("\n".join(twin_lines(args.runs) + calibration_lines() + campaign_lines()))
+
+
+if __name__ == "__main__":
+    main()
