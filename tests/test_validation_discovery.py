@@ -302,6 +302,17 @@ def test_mechanisms_the_data_cannot_show_are_not_tried():
     assert d.found == [] and len(d.steps) == 1
 
 
+def test_discovery_says_what_it_is_fitting():
+    """The progress hook hears the classical fit first, then each fit of a step with the model it extends (what the
+    command's status line shows)."""
+    rng = np.random.default_rng(3)
+    data = synthetic_measurements({}, rng, cond=conditions(slip_angles=(0.0,), gravities=(9.81,)))
+    heard = []
+    discover(data, seed=0, candidates=["slip_sinkage"], progress=heard.append)
+    assert heard[0].startswith("fitting the classical model to ")
+    assert "step 1: fitting classical + slip_sinkage" in heard[1:]
+
+
 def test_gravity_pressure_needs_three_gravity_levels():
     """With k'_c free, two gravity levels fix c k'_c + rho g b k'_phi g^-eps at both exactly: the exponent cannot
     be told from the split between k'_c and k'_phi, so the mechanism is not tried; a third level can show it."""

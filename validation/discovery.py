@@ -211,17 +211,20 @@ class _Search:
     the order the candidates are tried)."""
 
     def __init__(self, data, train, test, responses, scales, base_start, baseline: Fit, lack: dict, bootstrap: int,
-                 seed: int) -> None:
+                 seed: int, progress=None) -> None:
         self.data, self.train, self.test = data, train, test
         self.responses, self.scales, self.base_start, self.bootstrap = responses, scales, base_start, bootstrap
         self.rng = np.random.default_rng(seed)
         self.current, self.names, self.free = baseline, (), BASELINE_FREE
         self.lack = lack
         self.steps: list[Step] = []
+        self.progress = progress or (lambda message: None)
 
     def _fit(self, exts, current=None, free=None, **kw) -> Fit:
         current = self.current if current is None else current
         free = self.free if free is None else free
+        model = " + ".join(["classical", *self.names, *(e.name for e in exts)])
+        self.progress(f"step {len(self.steps) + 1}: fitting {model}")
         return _fit_extended(self.train, current, free, self.base_start, exts, self.responses, self.scales, **kw)
 
     def heldout_error(self, soil) -> np.ndarray:
@@ -364,25 +367,28 @@ class _Search:
 
 
 def discover(data: Measurements, *, start: SoilParameters | None = None, responses=None, heldout=None,
-             candidates=None, bootstrap: int = 400, seed: int = 0, max_steps: int = 4) -> Discovery:
+             candidates=None, bootstrap: int = 400, seed: int = 0, max_steps: int = 4, progress=None) -> Discovery:
     """Run the workflow on ``data`` (see the module docstring).
 
     start: parameters to start from; the baseline's extension parameters are switched off
         (:data:`~.extensions.BASELINE_OFF`). responses: which measured responses to fit (default: those
         with data). heldout: boolean mask of held-out rows (default: a seeded random 30 %). candidates:
         extension names to try (default: all that the data can show). max_steps: most mechanisms accepted.
+        progress: called with a line saying what is being fitted, before each fit (e.g. a command's status line).
     """
     responses, names = _checked_inputs(data, responses, candidates)
     heldout = holdout_mask(data, seed=seed) if heldout is None else np.asarray(heldout, bool)
     train, test = data.select(~heldout), data.select(heldout)
     scales = response_scales(train, responses)
     base_start = replace(start or SoilParameters(), **BASELINE_OFF)
+    if progress is not None:
+        progress(f"fitting the classical model to {len(train)} rows (three starts)")
     baseline = calibrate_baseline(train, base_start, responses, scales)
     lack_base, trends = _lack_of_fit(baseline.soil, train, responses, scales)
 
     skipped = {n: "the data cannot show it" for n in names if not EXTENSIONS[n].applies(data)}
     remaining = [n for n in names if n not in skipped]
-    search = _Search(data, train, test, responses, scales, base_start, baseline, lack_base, bootstrap, seed)
+    search = _Search(data, train, test, responses, scales, base_start, baseline, lack_base, bootstrap, seed, progress)
     while remaining and len(search.names) < max_steps:
         step, passing = search.step(remaining, max_steps)
         if not passing:

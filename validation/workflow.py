@@ -104,11 +104,12 @@ def test_errors(d, test: Measurements, *, seed: int = 0, bootstrap: int = 400) -
 
 def validate(data_arg: str, *, report: Path, holdout: str | None = None, responses=None, hidden: str | None = None,
              seed: int = 0, group: str | None = None, command: str = "", test: str | None = None,
-             shear_form: str = "independent", domain: str = "all") -> dict:
+             shear_form: str = "independent", domain: str = "all", progress=None) -> dict:
     """Load (or synthesise) the data, run discovery, write the report and ``model.json``; with ``test``, also
     predict that second dataset with the model fitted on the first. ``shear_form``: the model's shear form
     (:class:`~.terramechanics.SoilParameters`; "resultant" is the CMU lab's); ``domain``: the rows to use
-    (:func:`prepare`). Returns the findings dict."""
+    (:func:`prepare`); ``progress``: told what is being fitted (:func:`~.discovery.discover`). Returns the findings
+    dict."""
     if domain not in DOMAINS:
         raise WheelsoilInputError(f"--domain {domain!r}: choose one of {list(DOMAINS)}")
     start = SoilParameters(shear_form=shear_form)  # refuses an unknown form before any work
@@ -140,7 +141,8 @@ def validate(data_arg: str, *, report: Path, holdout: str | None = None, respons
         title = f"Validation against {data.name}"
         name = params = None
     mask = parse_holdout(holdout, data, seed)
-    d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed, start=start)
+    d = discover(data, responses=responses or default_responses, heldout=mask, seed=seed, start=start,
+                 progress=progress)
     extra = {"shear_form": shear_form, "domain": domain}
     if test_data is not None:
         extra["test"] = test_errors(d, test_data, seed=seed)
@@ -251,10 +253,11 @@ def main_validate(args) -> int:
                                     resume=getattr(args, "resume", False))
         console.print(f"wrote {cv['report']}")
         return 0
-    findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
-                        hidden=args.hidden, seed=args.seed, group=args.group, command=command,
-                        test=getattr(args, "test", None), shear_form=getattr(args, "shear_form", "independent"),
-                        domain=getattr(args, "domain", "all"))
+    with console.status("reading the data") as status:  # a status line: the fits' number is not known in advance
+        findings = validate(args.data, report=args.report, holdout=args.holdout, responses=args.responses,
+                            hidden=args.hidden, seed=args.seed, group=args.group, command=command,
+                            test=getattr(args, "test", None), shear_form=getattr(args, "shear_form", "independent"),
+                            domain=getattr(args, "domain", "all"), progress=status.update)
     base = findings["baseline"]
     console.print(f"classical model: RMSE {base['train_rmse']:.3f} (train), {base['heldout_rmse']:.3f} (held out); "
                   f"final model: {findings['final']['heldout_rmse']:.3f} (held out)")
