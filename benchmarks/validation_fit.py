@@ -28,6 +28,7 @@ import argparse
 import json
 import statistics
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -48,12 +49,8 @@ def fit(data, start, scales, variant: str) -> dict:
     """One fit under ``variant``: its wall time [s], SSE, fitted parameters and function evaluations' outcome."""
     rule, jacobian = VARIANTS[variant]
     t0 = time.perf_counter()
-    if rule is None:
+    with nullcontext() if rule is None else contact_rule(*rule):
         result = cal.calibrate(data, start, BASELINE_FREE, responses=cal.RESPONSES, scales=scales, jacobian=jacobian)
-    else:
-        with contact_rule(*rule):
-            result = cal.calibrate(data, start, BASELINE_FREE, responses=cal.RESPONSES, scales=scales,
-                                   jacobian=jacobian)
     return {"variant": variant, "wall_s": time.perf_counter() - t0, "sse": result.sse, "free": result.free,
             "success": result.success}
 

@@ -33,9 +33,9 @@ def twin_lines(runs: Path) -> list[str]:
         lines += [f"  {ln[:150]}" for ln in events[-2:]] or ["  (no case started yet)"]
     else:
         lines.append(f"  no log at {log}")
-    for path in sorted(runs.glob("*/cases/*/.checkpoint.h5")):
-        import h5py
+    import h5py
 
+    for path in sorted(runs.glob("*/cases/*/.checkpoint.h5")):
         with h5py.File(path, "r") as h5:
             t = float(h5.attrs.get("t", float("nan")))
         written = time.strftime("%Y-%m-%d %H:%M", time.localtime(os.path.getmtime(path)))

@@ -27,7 +27,7 @@ import numpy as np
 
 from wheelsoil.validation import synthetic as syn
 from wheelsoil.validation.quadrature import CONTACT_POINTS, GRADING_POWER, QUADRATURE_POINTS, contact_rule
-from wheelsoil.validation.terramechanics import contact_forces, predict
+from wheelsoil.validation.terramechanics import CheckedConditions, forces_at_sinkage, predict
 
 RESPONSES = ("drawbar_pull", "lateral_force", "vertical_force", "torque")
 REFERENCE = (400, 3)
@@ -52,8 +52,7 @@ def conditions() -> dict:
 
 def forces_at(soil, wheel, sinkage, cond, rule) -> dict:
     with contact_rule(*rule):
-        return contact_forces(soil, wheel, sinkage, cond["slip"], cond["slip_angle"], cond["gravity"],
-                              passes=cond["passes"], travel_slip=cond["travel_slip"], load=cond["load"])
+        return forces_at_sinkage(soil, wheel, sinkage, CheckedConditions.of(**cond))
 
 
 def braking_rows(cond: dict) -> np.ndarray:

@@ -247,23 +247,23 @@ def calibrate(data: Measurements, start: SoilParameters, free: tuple[Parameter, 
         return replace(start, **values)
 
     warm = WarmStarts()  # each evaluation starts its sinkage solves from the last one's roots
-    last: dict = {}  # the last evaluation: its coordinates, the predictions by wheel (None outside the domain)
+    last: dict = {}  # the last evaluation: coordinates, residuals, predictions by wheel (None outside the domain)
 
     def residual(x):
         last["x"], last["predictions"] = np.array(x, float), None
         try:
             last["predictions"] = wheel_predictions(soil_of(x), data, warm)
+            last["residuals"] = residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
         except WheelsoilInputError:  # a combination outside the model's domain (e.g. a1 + a2 > 1)
-            return np.full(n_res, OUTSIDE_RESIDUAL)
-        return residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
+            last["residuals"] = np.full(n_res, OUTSIDE_RESIDUAL)
+        return last["residuals"]
 
     def jacobian_through_sinkage(x):
         """Through the sinkage (:mod:`.fit_jacobian`), with scipy's two-point steps."""
         x = np.asarray(x, float)
         if "x" not in last or not np.array_equal(last["x"], x):
             residual(x)
-        r0 = (residuals_of(responses_of(last["predictions"], len(data)), data, responses, scales)
-              if last["predictions"] is not None else np.full(n_res, OUTSIDE_RESIDUAL))
+        r0 = last["residuals"]
         steps = forward_steps(x, lo, hi, DIFF_STEP)
         if last["predictions"] is None:  # outside the domain at x itself: plain forward differences
             return np.stack([(residual(x + steps[k] * np.eye(x.size)[k]) - r0) / steps[k] for k in range(x.size)],

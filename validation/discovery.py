@@ -211,14 +211,14 @@ class _Search:
     the order the candidates are tried)."""
 
     def __init__(self, data, train, test, responses, scales, base_start, baseline: Fit, lack: dict, bootstrap: int,
-                 seed: int, progress=None) -> None:
+                 seed: int, progress) -> None:
         self.data, self.train, self.test = data, train, test
         self.responses, self.scales, self.base_start, self.bootstrap = responses, scales, base_start, bootstrap
         self.rng = np.random.default_rng(seed)
         self.current, self.names, self.free = baseline, (), BASELINE_FREE
         self.lack = lack
         self.steps: list[Step] = []
-        self.progress = progress or (lambda message: None)
+        self.progress = progress
 
     def _fit(self, exts, current=None, free=None, **kw) -> Fit:
         current = self.current if current is None else current
@@ -381,8 +381,8 @@ def discover(data: Measurements, *, start: SoilParameters | None = None, respons
     train, test = data.select(~heldout), data.select(heldout)
     scales = response_scales(train, responses)
     base_start = replace(start or SoilParameters(), **BASELINE_OFF)
-    if progress is not None:
-        progress(f"fitting the classical model to {len(train)} rows (three starts)")
+    progress = progress or (lambda message: None)
+    progress(f"fitting the classical model to {len(train)} rows (three starts)")
     baseline = calibrate_baseline(train, base_start, responses, scales)
     lack_base, trends = _lack_of_fit(baseline.soil, train, responses, scales)
 

@@ -442,20 +442,20 @@ def predict(soil: SoilParameters, wheel: RigidWheel, *, slip=None, slip_angle=0.
     torque [N m], theta_f, theta_m, theta_r [rad], and ``supported`` (False where even z = max_sinkage_ratio r
     cannot carry W; those rows hold that sinkage).
     """
-    shape, i, beta, load, g, n_p, s_travel = _conditions(slip, slip_angle, load, gravity, passes, travel_slip)
-    beta_deg = np.degrees(beta)
+    c = CheckedConditions.of(slip=slip, slip_angle=slip_angle, load=load, gravity=gravity, passes=passes,
+                             travel_slip=travel_slip)
 
     def excess(z, rows):
-        return contact_forces(soil, wheel, z, i[rows], beta_deg[rows], g[rows], passes=n_p[rows], vertical_only=True,
-                              travel_slip=s_travel[rows], load=load[rows])["vertical_force"] - load[rows]
+        vertical = contact_forces(soil, wheel, z, c.slip[rows], c.slip_angle[rows], c.gravity[rows],
+                                  passes=c.passes[rows], vertical_only=True, travel_slip=c.travel_slip[rows],
+                                  load=c.load[rows])["vertical_force"]
+        return vertical - c.load[rows]
 
-    solution = solve_sinkage(excess, load, max_sinkage_ratio * wheel.radius, tolerance=tolerance,
+    solution = solve_sinkage(excess, c.load, max_sinkage_ratio * wheel.radius, tolerance=tolerance,
                              max_iterations=max_iterations, warm=warm_start)
-    z, supported = solution.sinkage, solution.supported
-    out = contact_forces(soil, wheel, z, i, beta_deg, g, passes=n_p, travel_slip=s_travel, load=load)
-    out["sinkage"] = z
-    out["supported"] = supported
-    return {k: np.reshape(v, shape) for k, v in out.items()}
+    sinkage = np.reshape(solution.sinkage, c.shape)
+    return {**forces_at_sinkage(soil, wheel, sinkage, c), "sinkage": sinkage,
+            "supported": np.reshape(solution.supported, c.shape)}
 
 
 @dataclass(frozen=True)

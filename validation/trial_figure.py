@@ -68,7 +68,7 @@ def plot_trials(data: Measurements, lines: dict[str, dict], path: str | Path, *,
     axes[0, 0].legend(fontsize=6)
     fig.tight_layout()
     for row, q in enumerate(responses):
-        _frame_on_data(axes[row], data, q, lines, points or {}, slip, angles)
+        _frame_on_data(axes[row], data, q, lines, points or {}, angles)
     path = Path(path)
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -92,7 +92,7 @@ def frame_limits(data: Measurements, q: str, points: dict) -> tuple[float, float
     return lo - pad, hi + pad
 
 
-def _frame_on_data(row_axes, data: Measurements, q: str, lines: dict, points: dict, slip, angles) -> None:
+def _frame_on_data(row_axes, data: Measurements, q: str, lines: dict, points: dict, angles) -> None:
     """Scale one row of panels (one response, shared y) to :func:`frame_limits`; a model line that leaves the frame
     (e.g. a model that cannot carry the load sinks to its deepest and drags hundreds of newtons) is clipped, and its
     panel says how far it goes."""
