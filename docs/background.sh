@@ -23,10 +23,13 @@ start() {  # start NAME PATTERN LOG COMMAND...
 }
 start "CMU twin queue (issue 34)" "cmu_twin_queue.py" "$RUNS/cmu_queue.log" \
   "$PY" docs/cmu_twin_queue.py --runs "$RUNS" --queue docs/cmu-twin/queue.json
-start "wide-box calibration (issue 33)" "soillab_calibration.py run --design epsd-box" \
-  docs/soillab/calibration-epsd-box-run.log \
-  "$PY" docs/soillab_calibration.py run --design epsd-box --box 0.6 0.6 0.12 \
-  --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface \
-  --out docs/soillab/calibration-epsd-box --resume --cache "$RUNS/lab-cache"
+# The calibration's last candidates, then (in the same slot, once all ten have finished) the checks owed on its choice.
+start "wide-box calibration, then its choice's checks (issue 33)" \
+  "soillab_calibration.py run --design epsd-box|choice-checks/run.sh" docs/soillab/calibration-epsd-box-run.log \
+  bash -c '"$0" docs/soillab_calibration.py run --design epsd-box --box 0.6 0.6 0.12 \
+    --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface \
+    --out docs/soillab/calibration-epsd-box --resume --cache "$1/lab-cache" \
+    && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
+  "$PY" "$RUNS"
 start "signed-slip campaigns (issue 36)" "validation/campaigns/signed-slip.sh|validation_campaign.py" "$RUNS/signed-slip.out" \
   bash docs/validation/campaigns/signed-slip.sh

@@ -2,7 +2,8 @@
 
 * the CMU twin's queue (``docs/cmu-twin/queue.json``): its last start and end in ``RUNS/cmu_queue.log``, and for each
   case that has a checkpoint under ``RUNS/*/cases`` its simulated time and when it was written;
-* the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective;
+* the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective,
+  then the checks on its choice (``docs/soillab/choice-checks/run.sh``): the steps finished and the last log line;
 * the validation campaigns that ``docs/validation/campaigns/signed-slip.sh`` runs: the draws each has of its target.
 
 Reads files only (it starts and stops nothing), so it can run beside the jobs::
@@ -22,6 +23,7 @@ CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "signed-slip.sh"
 CALIBRATION = ROOT / "docs" / "soillab" / "calibration-epsd-box" / "candidates"
 #: Candidates in the wide-box design (the nine grid points and the earlier surface minimum, docs/soillab/README.md).
 CALIBRATION_CANDIDATES = 10
+CHOICE_CHECKS = ROOT / "docs" / "soillab" / "choice-checks"
 
 
 def twin_lines(runs: Path) -> list[str]:
@@ -57,6 +59,14 @@ def calibration_lines() -> list[str]:
     if done:
         best = min(done)
         lines.append(f"  least objective so far: {best[1]} ({best[0]:.3f})")
+    steps = sorted(p.parent.name for p in CHOICE_CHECKS.glob("*/*.json") if p.parent.name != "scale")
+    scale = sorted(p.stem for p in (CHOICE_CHECKS / "scale" / "runs").glob("*.json"))
+    log = CHOICE_CHECKS / "run.log"
+    if steps or scale or log.is_file():
+        lines.append(f"  checks on the choice: {', '.join(steps + scale) or 'none finished'}")
+        if log.is_file():
+            last = [ln for ln in log.read_text().splitlines() if ln.strip() and not ln.startswith("[Taichi]")]
+            lines += [f"  log: {last[-1][:140]}"] if last else []
     return lines
 
 

@@ -105,6 +105,21 @@ def reused_row(folders, name: str) -> dict | None:
     return None
 
 
+def lab_particles(mu: float, mu_r: float, law: str, density: float):
+    """(material, particle pair, tool pair) of a candidate: the lab's stiffness and restitution, sliding friction
+    ``mu``, rolling friction ``mu_r`` under the rolling law ``law`` for particles and tools alike, particle density
+    ``density`` [kg/m^3]."""
+    from wheelsoil.material import Material, PairProperties
+    from wheelsoil.parameters import soil_lab
+
+    base = soil_lab.PARTICLE_MATERIAL
+    material = Material("calibration", youngs_modulus=base.youngs_modulus, poisson_ratio=base.poisson_ratio,
+                        density=density)
+    pair = PairProperties(restitution=soil_lab.PARTICLE_PAIR.restitution, static_friction=mu, rolling_friction=mu_r,
+                          rolling_model=law)
+    return material, pair, dataclasses.replace(soil_lab.TOOL_PAIR, rolling_model=law)
+
+
 def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = False, law: str = "cdt",
               box: dict | None = None, reused: dict | None = None, checkpoints: Path | None = None) -> dict:
     """One candidate through the lab: density, repose and (``shear``) the shear box in the lab's box, unless
@@ -113,18 +128,13 @@ def candidate(mu: float, mu_r: float, cache, pour: float = 1.0, shear: bool = Fa
     from wheelsoil import soillab
     from wheelsoil.granular.bed import prepare_bed
     from wheelsoil.granular.bed_spec import BedSpec
-    from wheelsoil.material import Material, PairProperties
     from wheelsoil.parameters import cmu_k10, soil_lab
 
     start = time.perf_counter()
     base = soil_lab.PARTICLE_MATERIAL
-    pair = PairProperties(restitution=soil_lab.PARTICLE_PAIR.restitution, static_friction=mu, rolling_friction=mu_r,
-                          rolling_model=law)
-    tool_pair = dataclasses.replace(soil_lab.TOOL_PAIR, rolling_model=law)
 
     def spec(density, where=soil_lab.PLATE_BOX):
-        material = Material("calibration", youngs_modulus=base.youngs_modulus, poisson_ratio=base.poisson_ratio,
-                            density=density)
+        material, pair, tool_pair = lab_particles(mu, mu_r, law, density)
         return BedSpec(**where, diameter_min=soil_lab.DIAMETER_MIN, diameter_max=soil_lab.DIAMETER_MAX,
                        material=material, pair=pair, wall_material=soil_lab.TOOL_MATERIAL,
                        wall_pair=tool_pair, periodic=False, seed=0, pour_friction_factor=pour)
@@ -240,6 +250,24 @@ def summary(args) -> int:
     return 0
 
 
+def choice(args) -> int:
+    """Print the path of the design's choice by its rule (the least objective, every candidate scored again from its
+    stored curves); refuse while any of the design's candidates has not finished."""
+    folder = Path(args.out) / "candidates"
+    names = [candidate_name(mu, mu_r, pour, law) for mu, mu_r, pour, _, law in DESIGNS[args.design]]
+    missing = [name for name in names if not (folder / f"{name}.json").is_file()]
+    if missing:
+        print(f"{args.out}: design {args.design!r} has {len(names) - len(missing)} of {len(names)} candidates; "
+              f"not finished: {', '.join(missing)}", file=sys.stderr)
+        return 1
+    rows = {name: json.loads((folder / f"{name}.json").read_text()) for name in names}
+    chosen = objective_best(list(rows.values()))
+    name = candidate_name(chosen["friction"], chosen["rolling_friction"], chosen.get("pour_friction_factor", 1.0),
+                          chosen["rolling_model"])
+    print(folder / f"{name}.json")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -259,6 +287,10 @@ def main(argv=None) -> int:
     p = sub.add_parser("summary")
     p.add_argument("out", nargs="?", default="docs/soillab/calibration")
     p.set_defaults(func=summary)
+    p = sub.add_parser("choice", help="the path of the design's chosen candidate (fails until all have finished)")
+    p.add_argument("out")
+    p.add_argument("--design", choices=sorted(DESIGNS), required=True)
+    p.set_defaults(func=choice)
     args = parser.parse_args(argv)
     return args.func(args)
 

@@ -5,6 +5,7 @@ Usage (from the repository root, ``../shared`` beside it; about 4, 10 and 25 min
 
     python docs/soillab_scale.py run --out docs/soillab/scale [--resume] [--cache DIR] [--seeds 0 1]
     python docs/soillab_scale.py summary docs/soillab/scale
+    python docs/soillab_scale.py run --out DIR --candidate CANDIDATE.json --box L W D [--scales 1 0.8 0.64] [...]
 
 What it does, fixed before any result was seen:
 
@@ -35,17 +36,38 @@ DIAMETER = 0.1
 TOLERANCE = 0.10
 
 
-def one_run(scale: float, seed: int, cache) -> dict:
+def particles(candidate: str | None):
+    """(material, particle pair, tool pair, pour friction factor) of the study: the lab's default particles, or those
+    of a calibration candidate's file (``docs/soillab_calibration.py``: its friction, rolling friction and law, pour
+    factor and the density its bed was poured at, with the calibration's stiffness, restitution and tools)."""
+    from wheelsoil.parameters import soil_lab
+
+    if candidate is None:
+        return soil_lab.PARTICLE_MATERIAL, soil_lab.PARTICLE_PAIR, soil_lab.TOOL_PAIR, 1.0
+    from soillab_calibration import lab_particles
+
+    row = json.loads(Path(candidate).read_text())
+    material, pair, tool = lab_particles(row["friction"], row["rolling_friction"], row["rolling_model"], row["density"])
+    return material, pair, tool, row.get("pour_friction_factor", 1.0)
+
+
+def one_run(scale: float, seed: int, cache, candidate: str | None = None, box: dict | None = None,
+            checkpoint: Path | None = None, checkpoint_every: int = 10) -> dict:
+    """The 100 mm plate on the particles (:func:`particles`) scaled by ``scale``, seed ``seed``, in ``box`` (default
+    the lab's plate box); with ``checkpoint`` (a file) its state kept every ``checkpoint_every`` samples, so that an
+    interrupted plate continues (``soillab.plate_test``)."""
     from wheelsoil import soillab
     from wheelsoil.granular.bed_spec import BedSpec
     from wheelsoil.parameters import soil_lab
 
     start = time.perf_counter()
-    bed_spec = BedSpec(**soil_lab.PLATE_BOX, diameter_min=soil_lab.DIAMETER_MIN * scale,
-                       diameter_max=soil_lab.DIAMETER_MAX * scale, material=soil_lab.PARTICLE_MATERIAL,
-                       pair=soil_lab.PARTICLE_PAIR, wall_material=soil_lab.TOOL_MATERIAL, wall_pair=soil_lab.TOOL_PAIR,
-                       periodic=False, seed=seed)
-    result = soillab.plate_test(bed_spec, soillab.PlateSpec(diameter=DIAMETER), cache_dir=cache)
+    material, pair, tool_pair, pour = particles(candidate)
+    bed_spec = BedSpec(**(box or soil_lab.PLATE_BOX), diameter_min=soil_lab.DIAMETER_MIN * scale,
+                       diameter_max=soil_lab.DIAMETER_MAX * scale, material=material, pair=pair,
+                       wall_material=soil_lab.TOOL_MATERIAL, wall_pair=tool_pair, periodic=False, seed=seed,
+                       pour_friction_factor=pour)
+    keep = {} if checkpoint is None else {"checkpoint": checkpoint, "checkpoint_every": checkpoint_every}
+    result = soillab.plate_test(bed_spec, soillab.PlateSpec(diameter=DIAMETER), cache_dir=cache, **keep)
     z = np.array(SINKAGES)
     force, _, _ = soillab.mean_curve([result.curve], z)
     return {"scale": scale, "seed": seed, "mean_diameter_m": 0.5 * (bed_spec.diameter_min + bed_spec.diameter_max),
@@ -59,19 +81,31 @@ def one_run(scale: float, seed: int, cache) -> dict:
 def run(args) -> int:
     out = Path(args.out)
     (out / "runs").mkdir(parents=True, exist_ok=True)
+    box = dict(zip(("length", "width", "depth"), args.box)) if args.box else None
     for seed in args.seeds:
-        for scale in SCALES:
+        for scale in args.scales:
             path = out / "runs" / f"scale{scale:g}_seed{seed}.json"
             if args.resume and path.is_file():
                 print(f"{path.name}: done before, kept", flush=True)
                 continue
-            row = one_run(scale, seed, args.cache)
+            keep = {} if args.checkpoint_every is None else {
+                "checkpoint": path.with_name(f".{path.stem}.checkpoint.h5"), "checkpoint_every": args.checkpoint_every}
+            row = one_run(scale, seed, args.cache, candidate=args.candidate, box=box, **keep)
+            if args.candidate:
+                row["candidate"] = args.candidate
+            row["box_m"] = list((box or _plate_box()).values())
             tmp = path.with_suffix(".partial")
             tmp.write_text(json.dumps(row, indent=1))
             tmp.replace(path)
             p = ", ".join(f"{1e3 * z:g} mm {1e-3 * v:.1f} kPa" for z, v in zip(row["sinkage_m"], row["pressure_Pa"]))
             print(f"{path.name}: {row['particles']} particles, {p}; {row['wall_seconds']:.0f} s", flush=True)
     return summary(args)
+
+
+def _plate_box() -> dict:
+    from wheelsoil.parameters import soil_lab
+
+    return dict(soil_lab.PLATE_BOX)
 
 
 def extrapolate(rows: list[dict]) -> list[dict]:
@@ -140,6 +174,16 @@ def main(argv=None) -> int:
     p.add_argument("--resume", action="store_true")
     p.add_argument("--cache", default=None)
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
+    p.add_argument("--scales", type=float, nargs="+", default=list(SCALES),
+                   help="particle scales [-] (default 1 0.8 0.64)")
+    p.add_argument("--candidate", default=None, metavar="JSON",
+                   help="a calibration candidate's file (docs/soillab_calibration.py): its particles instead of the "
+                        "lab's defaults")
+    p.add_argument("--box", type=float, nargs=3, default=None, metavar=("LENGTH", "WIDTH", "DEPTH"),
+                   help="the plate's box [m] (default the lab's 0.3 x 0.3 x 0.12 m)")
+    p.add_argument("--checkpoint-every", type=int, default=None, metavar="SAMPLES",
+                   help="keep each plate's state every SAMPLES samples beside its result, so that a run interrupted "
+                        "continues with --resume (another trajectory than without; default: none)")
     p.set_defaults(func=run)
     p = sub.add_parser("summary")
     p.add_argument("out", nargs="?", default="docs/soillab/scale")

@@ -82,6 +82,7 @@ def write_shear(result: ShearResult, folder: Path) -> tuple[dict, dict[str, Path
                       "cohesion_Pa": mc.cohesion, "cohesion_se_Pa": mc.cohesion_se}
                 for key, mc in (("peak", result.peak), ("residual", result.residual))}
     figures = {**envelope, "particles": result.particles, "bulk_density_kg_m3": result.bulk_density,
+               "shear_speed_m_s": result.speed,
                "runs": [{"imposed_normal_Pa": r.normal_stress, "measured_normal_Pa": r.mean_normal,
                          "shear_plane_normal_Pa": r.plane_normal, "peak_Pa": r.peak,
                          "peak_displacement_m": r.peak_displacement, "peak_reached": r.peak_reached,

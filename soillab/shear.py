@@ -78,11 +78,15 @@ class MohrCoulomb:
 
 @dataclass(frozen=True)
 class ShearResult:
+    """The shear box at every normal stress: each run, the peak and residual envelopes, the sample's particle count
+    and bulk density [kg/m^3], and the upper ring's shear speed [m/s]."""
+
     runs: tuple[ShearRun, ...]
     peak: MohrCoulomb
     residual: MohrCoulomb
     particles: int
     bulk_density: float
+    speed: float
 
 
 def mohr_coulomb(normal, shear) -> MohrCoulomb:
@@ -192,4 +196,4 @@ def shear_test(bed_spec: BedSpec, spec: ShearSpec, *, cache_dir=None, arch: str 
     normal = [r.plane_normal for r in runs]
     return ShearResult(tuple(runs), mohr_coulomb(normal, [r.peak for r in runs]),
                        mohr_coulomb(normal, [r.residual for r in runs]), bed.n_particles,
-                       bed.packing_fraction * spec_bed.material.density)
+                       bed.packing_fraction * spec_bed.material.density, spec.speed)

@@ -144,3 +144,23 @@ def test_a_box_for_a_soil_lab_test_with_its_own_apparatus_is_refused_and_the_pou
     args = build_parser().parse_args(["soil-lab", "poured", "--box", "0.3", "0.3", "0.24", "--seeds", "0"])
     _, bed, _ = soil_lab._specs(args)
     assert (bed.length, bed.width, bed.depth) == (0.3, 0.3, 0.24)  # a poured bed in the box asked for
+
+
+def test_the_soil_labs_speed_sets_the_shear_box_or_the_press_and_is_refused_where_there_is_none(tmp_path, capsys):
+    """--speed: the shear box's shear speed for the shear test, the pressing speed for plate and wheel, each test's own
+    default without it; a test without a speed, or a speed outside the spec's range, is refused naming the value."""
+    from wheelsoil.cases.cli import build_parser
+    from wheelsoil.cases.commands import soil_lab
+    from wheelsoil.parameters import soil_lab as lab
+
+    def spec(*argv):
+        return soil_lab._specs(build_parser().parse_args(["soil-lab", *argv]))[2]
+
+    assert spec("shear", "--speed", "0.01").speed == 0.01
+    assert spec("shear").speed == lab.SHEAR["speed"]
+    assert [s.speed for s in spec("plate", "--speed", "0.015")] == [0.015] * len(lab.PLATE_DIAMETERS)
+    assert [s.speed for s in spec("plate")] == [lab.PRESS["speed"]] * len(lab.PLATE_DIAMETERS)
+    assert spec("wheel", "--speed", "0.02").speed == 0.02
+    _refused(["soil-lab", "repose", "--speed", "0.01", "--out", str(tmp_path / "lab")], capsys,
+             "--speed 0.01", "the repose test has no speed")
+    _refused(["soil-lab", "shear", "--speed", "2", "--out", str(tmp_path / "lab")], capsys, "speed = 2")

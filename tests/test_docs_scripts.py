@@ -381,3 +381,86 @@ def test_the_background_status_reads_the_queue_log_and_the_campaign_list(tmp_pat
     script = status.CAMPAIGN_SCRIPT.read_text()
     listed = [re.match(r"  (\w+)-(\d+): \d+ of (\d+) draws", ln) for ln in status.campaign_lines()[1:]]
     assert listed and all(m and f'"{m[1]} {m[3]} {m[2]}"' in script for m in listed)
+
+
+def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monkeypatch, measured_dir):
+    """docs/soillab_choice_checks.py on synthetic results of run.sh's steps: the calibration's choice by its rule,
+    the repose's mean and spread with seed 0 against the calibration's, the shear box's verdict at 10 % (one stress
+    changed by 12 %), each seed's objective as the calibration scores it, and the scale's line through the scale
+    runs and the x1 replicas (exactly linear in the mean diameter with a symmetric spread at x1: the line's own
+    intercept)."""
+    from wheelsoil.parameters import cmu_sand
+    from wheelsoil.soillab.objective import score
+
+    checks = _load("soillab_choice_checks")
+    calibration = _load("soillab_calibration")
+    monkeypatch.syspath_prepend(str(DOCS))
+    sinkages = [0.005, 0.01, 0.015, 0.02, 0.025]
+    measured = {"0.06": [3e3, 7e3, 12e3, 18e3, 26e3], "0.1": [5e3, 13e3, 23e3, 35e3, float("nan")]}
+
+    def plates(factor):
+        return {d: {"sinkage_m": sinkages, "simulated_Pa": [factor * m if m == m else 40e3 for m in mea],
+                    "measured_Pa": mea, "measured_sd_Pa": [0.1 * m for m in mea]} for d, mea in measured.items()}
+
+    cands = tmp_path / "calibration" / "candidates"
+    cands.mkdir(parents=True)
+    for k, (mu, mu_r, pour, _, law) in enumerate(calibration.DESIGNS["epsd-box"]):
+        chosen = (mu, mu_r) == (0.52, 0.5)
+        row = {"friction": mu, "rolling_friction": mu_r, "pour_friction_factor": pour, "rolling_model": law,
+               "density": cmu_sand.PARTICLE_MATERIAL.density if chosen else 2400.0 + k,
+               "repose_deg": 28.0 if chosen else 25.0 + 0.1 * k, "plates": plates(1.2 if chosen else 1.5 + 0.1 * k)}
+        (cands / f"{calibration.candidate_name(mu, mu_r, pour, law)}.json").write_text(json.dumps(row))
+    out = tmp_path / "checks"
+
+    def write(path, data):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(data))
+
+    write(out / "repose" / "repose.json", {"angles_deg": [28.5, 29.5, 30.5]})
+    stresses = [5e3, 10e3, 20e3]
+    write(out / "shear-20mms" / "shear.json", {"runs": [{"imposed_normal_Pa": s, "peak_Pa": s} for s in stresses],
+                                               "peak": {"friction_angle_deg": 45.0}})
+    write(out / "shear-10mms" / "shear.json", {"runs": [{"imposed_normal_Pa": s, "peak_Pa": s * f}
+                                                        for s, f in zip(stresses, (1.05, 0.97, 1.12))],
+                                               "peak": {"friction_angle_deg": 46.0}})
+    wide = {}
+    p0, slope = 10e3, 1e6  # the 100 mm plate's pressure at every scale sinkage: p0 + slope * d, +-1 % at x1
+    for seed, spread in ((1, 1.01), (2, 0.99)):
+        write(out / f"plate-seed{seed}" / "plate.json", {"pressure": [
+            {"diameter_m": 0.06, "sinkage_m": z, "simulated_Pa": 1.1 * seed * m} for z, m in zip(sinkages,
+                                                                                               measured["0.06"])]})
+        wide[seed] = tmp_path / f"wide-seed{seed}"
+        write(wide[seed] / "plate.json", {"pressure": [
+            {"diameter_m": 0.1, "sinkage_m": z, "simulated_Pa": spread * (p0 + slope * 0.008)} for z in sinkages]})
+    for scale, d in ((1.0, 0.008), (0.8, 0.0064), (0.64, 0.00512)):
+        write(out / "scale" / "runs" / f"scale{scale:g}_seed0.json",
+              {"scale": scale, "seed": 0, "mean_diameter_m": d, "pressure_Pa": [p0 + slope * d] * 4})
+    monkeypatch.setattr(checks, "CALIBRATION", tmp_path / "calibration")
+    monkeypatch.setattr(checks, "WIDE_BOX_SEEDS", wide)
+    monkeypatch.setattr(checks, "CMU_SAND_WHEELS", tmp_path / "no-wheels")
+
+    assert checks.main(["--out", str(out)]) == 0
+    report = json.loads((out / "summary.json").read_text())
+    assert report["choice"]["cmu_sand"] and report["choice"]["friction"] == 0.52
+    rep = report["repose"]
+    assert rep["mean_deg"] == pytest.approx(29.5) and rep["sd_deg"] == pytest.approx(1.0)
+    assert rep["seed0_change_deg"] == pytest.approx(0.5)
+    shear = report["shear_speed"]
+    assert shear["change"] == pytest.approx([0.05, -0.03, 0.12]) and shear["quasi_static"] is False
+    per_seed = report["plates"]["per_seed"]
+    assert sorted(per_seed) == ["0", "1", "2"]
+    for seed, angle in zip("012", (28.5, 29.5, 30.5)):
+        pressures = per_seed[seed]["pressure_Pa"]
+        expected = score({"plates": {d: {"simulated_Pa": pressures[d], "measured_Pa": measured[d]} for d in measured},
+                          "repose_deg": angle})
+        assert per_seed[seed]["objective"] == pytest.approx(expected["objective"], rel=1e-12)
+    assert per_seed["1"]["pressure_Pa"]["0.06"] == pytest.approx([1.1 * m for m in measured["0.06"]])
+    objectives = [per_seed[s]["objective"] for s in "012"]
+    assert report["plates"]["objective_sd"] == pytest.approx(np.std(objectives, ddof=1))
+    assert report["runner_up"]["gap"] > 0
+    assert [w["seeds"] for w in report["wheels"].values()] == [[], []]
+    extrapolation = report["scale"]["extrapolation"]
+    assert [e["points"] for e in extrapolation] == [5] * 4
+    assert all(e["p0_Pa"] == pytest.approx(p0, rel=1e-9) for e in extrapolation)
+    text = (out / "summary.md").read_text()
+    assert "Not quasi-static" in text and "not run yet" in text

@@ -56,7 +56,9 @@ def add_parser(sub) -> None:
     t.add_argument("--box", type=float, nargs=3, default=None, metavar=("LENGTH", "WIDTH", "DEPTH"),
                    help="the bed's box [m] (poured, plate, wheel; default the parameter set's: the plate's for "
                         "the poured bed)")
-    t.add_argument("--speed", type=float, default=soil_lab.PRESS["speed"], help="pressing speed [m/s]")
+    t.add_argument("--speed", type=float, default=None,
+                   help=f"pressing speed (plate, wheel; default {soil_lab.PRESS['speed']:g}) or the shear box's shear "
+                        f"speed (shear; default {soil_lab.SHEAR['speed']:g}) [m/s]")
     t.add_argument("--max-sinkage", type=float, default=soil_lab.PRESS["max_sinkage"], help="pressing depth [m]")
     t.add_argument("--wheel", choices=("smooth", "grouser"), default="smooth", help="the CMU wheel (wheel)")
     t.add_argument("--stresses", type=float, nargs="+", default=list(soil_lab.SHEAR["normal_stresses"]),
@@ -113,9 +115,13 @@ def _specs(args):
     from wheelsoil import soillab
 
     seeds = args.seeds or ([0] if args.test in ("plate", "wheel", "shear") else list(soil_lab.POURED_SEEDS))
+    press_speed = soil_lab.PRESS["speed"] if args.speed is None else args.speed
     if args.box and args.test in ("repose", "shear"):
         raise WheelsoilInputError(f"--box {' '.join(f'{v:g}' for v in args.box)}: the {args.test} test has its own "
                                   "apparatus; --box sets the bed of the poured, plate and wheel tests")
+    if args.speed is not None and args.test in ("poured", "repose"):
+        raise WheelsoilInputError(f"--speed {args.speed:g}: the {args.test} test has no speed to set; --speed sets the "
+                                  "plate's and wheel's pressing speed and the shear box's shear speed")
     if args.test == "poured":
         box = dict(zip(("length", "width", "depth"), args.box)) if args.box else soil_lab.PLATE_BOX
         return seeds, _bed_spec(args, box, seeds[0]), None
@@ -123,18 +129,19 @@ def _specs(args):
         spec = soillab.ReposeSpec(seeds=tuple(seeds))
         return seeds, _bed_spec(args, soil_lab.PLATE_BOX, seeds[0]), spec
     if args.test == "shear":
-        spec = soillab.ShearSpec(normal_stresses=tuple(args.stresses))
+        speed = {} if args.speed is None else {"speed": args.speed}
+        spec = soillab.ShearSpec(normal_stresses=tuple(args.stresses), **speed)
         return seeds, _bed_spec(args, soil_lab.PLATE_BOX, seeds[0]), spec
     if args.test == "plate":
         box = dict(zip(("length", "width", "depth"), args.box)) if args.box else soil_lab.PLATE_BOX
-        specs = [soillab.PlateSpec(diameter=d, speed=args.speed, max_sinkage=args.max_sinkage) for d in args.plate]
+        specs = [soillab.PlateSpec(diameter=d, speed=press_speed, max_sinkage=args.max_sinkage) for d in args.plate]
         bed = _bed_spec(args, box, seeds[0])
         for s in specs:
             soillab.specs.check_plate_fits("plate diameter", s.diameter, bed.length, bed.width)
             soillab.specs.check_resolution("plate diameter", s.diameter, bed.diameter_max)
         return seeds, bed, specs
     box = dict(zip(("length", "width", "depth"), args.box)) if args.box else soil_lab.WHEEL_BOX
-    spec = soillab.WheelPressSpec(wheel=args.wheel, speed=args.speed, max_sinkage=args.max_sinkage)
+    spec = soillab.WheelPressSpec(wheel=args.wheel, speed=press_speed, max_sinkage=args.max_sinkage)
     return seeds, _bed_spec(args, box, seeds[0]), spec
 
 
