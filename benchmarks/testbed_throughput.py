@@ -18,7 +18,8 @@ and a measured extrapolation to seed-004 scale (388,026 particles, the full-reso
 
 Run:  python -m wheelsoil.benchmarks.testbed_throughput [--out benchmarks/results/testbed.json] [--arch cuda]
       python -m wheelsoil.benchmarks.testbed_throughput --cmu --out benchmarks/results/testbed-cmu.json
-        (only the CMU twin's scale: part 1 on ``cmu-grouser``)
+        (only the CMU twin's scale: part 1 on ``cmu-grouser``; ``--set KEY=VALUE ...`` changes the case, e.g. the
+        particles' size for the rig at about 100,000 particles)
       python -m wheelsoil.benchmarks.testbed_throughput --compare-pinning 3 --drive-time 0.05
         (only the A/B of pinned and unpinned worker threads, :mod:`wheelsoil.threads`, in alternating processes)
 """
@@ -61,16 +62,18 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
 COUPLED_PARTS = {"smoke": "smoke-1g-steer", "cmu": "cmu-grouser"}
 
 
-def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"], rounds: int = 6) -> dict:
+def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"], rounds: int = 6,
+               overrides: tuple[str, ...] = ()) -> dict:
     """The whole protocol of ``preset`` with a short drive, then ``steps`` timed DEM steps of steady driving by part,
     alternating in ``rounds`` chunks with as many steps of the same bed alone (module docstring, part 1; ``preset``
-    cmu-grouser: the CMU twin's rigid wheel on its calibrated sand, issue 37 item 2)."""
+    cmu-grouser: the CMU twin's rigid wheel on its calibrated sand, issue 37 item 2). ``overrides``: the case's
+    ``KEY=VALUE`` settings (as ``wheelsoil run --set``), e.g. finer particles for the rig at its own scale."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed
     from wheelsoil.granular import prepare_bed
 
-    case = load_case(preset, [f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
+    case = load_case(preset, [*overrides, f"test.drive_time={drive_time!r}", "test.stop_when_steady=false",
                               f"output.average_time={min(0.1, 0.5 * drive_time)!r}", "output.render=false"])
     bed = prepare_bed(build.bed_spec(case), arch=arch)
     t0 = time.perf_counter()
@@ -82,6 +85,7 @@ def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS[
     info = result.info
     out = {
         "case": case.name,
+        "overrides": list(overrides),
         "particles": info["particles"],
         "fe_elements": info["fe_elements"],
         "contact_facets": info["contact_facets"],
@@ -311,7 +315,8 @@ def cmu_scale(args) -> int:
     """The CMU twin's coupled step against its bed alone; prints and writes ``--out``."""
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
-    cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"], args.rounds)
+    cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"], args.rounds,
+                                     tuple(args.set))
     print(f"CMU scale ({cmu['case']}): {cmu['particles']} particles, rigid wheel of {cmu['fe_elements']} elements; "
           f"{cmu['wall_seconds_per_simulated_second']:.0f} s wall per simulated s over the protocol; per DEM step "
           f"{cmu['ms_per_step']:.2f} ms = soil {cmu['ms_per_step_soil']:.2f} + wheel {cmu['ms_per_step_wheel']:.2f} + "
@@ -339,8 +344,13 @@ def main(argv=None) -> int:
     ap.add_argument("--cmu", action="store_true",
                     help="only the CMU twin's scale (cmu-grouser: rigid wheel, about 21,500 particles): the coupled "
                          "step by part against the same bed alone (issue 37 item 2)")
+    ap.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
+                    help="with --cmu: the case's settings as in wheelsoil run --set, e.g. soil.diameter_min=0.003072 "
+                         "soil.diameter_max=0.004608 for the rig at about 100,000 particles")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.set and not args.cmu:
+        ap.error("--set applies to the CMU part only (--cmu)")
     if args.rounds < 1 or args.steps < 10 * args.rounds:
         ap.error(f"--rounds {args.rounds} and --steps {args.steps}: give at least one round and 10 steps per round")
     if args.part:
