@@ -209,6 +209,14 @@ def scale(out: Path, plate_seeds: dict[int, dict[str, list[float]]], row: dict) 
             "scales_run": sorted({r["scale"] for r in rows}, reverse=True)}
 
 
+def _section(lines: list[str], title: str, check: dict) -> bool:
+    """Append the check's heading (and "Not run yet." when it is missing); whether it has results to show."""
+    lines += [f"## {title}", ""]
+    if "missing" in check:
+        lines += ["Not run yet.", ""]
+    return "missing" not in check
+
+
 def markdown(report: dict) -> str:
     c = report["choice"]
     lines = [f"# Issue 33's checks on the calibration's choice: sliding {c['friction']:g}, rolling "
@@ -217,18 +225,12 @@ def markdown(report: dict) -> str:
              f"(rules fixed there before any of them ran). The choice: `{c['path']}`"
              + (" (cmu_sand's own particles)." if c["cmu_sand"] else " (not cmu_sand's particles)."), ""]
     r = report["repose"]
-    lines += ["## Repose (draw-down, seeds 0–2)", ""]
-    if "missing" in r:
-        lines += ["Not run yet.", ""]
-    else:
+    if _section(lines, "Repose (draw-down, seeds 0–2)", r):
         lines += [f"{' / '.join(f'{a:.1f}' for a in r['angles_deg'])}°: **{r['mean_deg']:.1f} ± {r['sd_deg']:.1f}°** "
                   f"(mean ± sd; the sand 29°). Seed 0 against the calibration's own draw-down "
                   f"({r['calibration_seed0_deg']:.2f}°): {r['seed0_change_deg']:+.2f}°.", ""]
     s = report["shear_speed"]
-    lines += ["## The shear box at half its speed", ""]
-    if "missing" in s:
-        lines += ["Not run yet.", ""]
-    else:
+    if _section(lines, "The shear box at half its speed", s):
         lines += ["| normal stress [kPa] | peak at 20 mm/s [kPa] | at 10 mm/s [kPa] | change |", "|---|---|---|---|"]
         lines += [f"| {1e-3 * n:g} | {1e-3 * a:.2f} | {1e-3 * b:.2f} | {100 * ch:+.1f} % |"
                   for n, a, b, ch in zip(s["normal_stresses_Pa"], s["peak_20mms_Pa"], s["peak_10mms_Pa"], s["change"])]
@@ -279,10 +281,7 @@ def markdown(report: dict) -> str:
         lines += ["", "Log-force error per seed: " + ", ".join(f"seed {s} {v:.3f}" for s, v in e["log_mse"].items())
                   + ".", ""]
     sc = report["scale"]
-    lines += ["## Particle scale of the 100 mm plate (wide box)", ""]
-    if "missing" in sc:
-        lines += ["Not run yet.", ""]
-    else:
+    if _section(lines, "Particle scale of the 100 mm plate (wide box)", sc):
         lines += [f"Scales run: {', '.join(f'×{x:g}' for x in sc['scales_run'])} (seed 0), with the ×1 replicas "
                   f"(seeds {', '.join(str(r['seed']) for r in sc['replica_points'])}) as further points.", "",
                   "| sinkage [mm] | points | p0 [kPa] | the lab's particles [kPa] | scale error | converged (10 %, 2 SE) |",
