@@ -268,6 +268,79 @@ def choice(args) -> int:
     return 0
 
 
+def figure(args) -> int:
+    """The calibration's plates in one figure (issue 33): a panel per plate size, pressure against sinkage, the
+    sand's measured trials (thin lines; both boxes) with their mean and standard deviation at the objective's
+    sinkages, every candidate of the folder faint and the least objective bold (the design's choice once all of its
+    candidates have finished; "least so far" before), with ``--seed-plates``' curves beside it: ``wheelsoil soil-lab
+    plate`` folders of other seeds, which must be of the chosen particles (their files do not say)."""
+    from wheelsoil import soillab
+    from wheelsoil.plotting import pyplot
+
+    paths = sorted(Path(args.out).glob("candidates/*.json"))
+    if not paths:
+        print(f"{args.out}: no candidate finished yet", file=sys.stderr)
+        return 1
+    rows = [score(json.loads(p.read_text())) for p in paths]
+    chosen = objective_best(rows)
+    complete = len(rows) == len(DESIGNS[args.design])
+    measured = soillab.load_plate_curves()
+    seeds = []
+    for folder in args.seed_plates or []:
+        path = Path(folder) / "plate.csv"
+        if not path.is_file():
+            print(f"--seed-plates {folder}: no plate.csv", file=sys.stderr)
+            return 1
+        seeds.append(pd_read(path))
+    plt = pyplot()
+    diameters = sorted(chosen["plates"], key=float)
+    fig, axes = plt.subplots(1, len(diameters), figsize=(5.2 * len(diameters), 4.2), squeeze=False)
+    for ax, d in zip(axes[0], diameters):
+        for k, curve in enumerate(c for c in measured if f"{c.size:g}" == d):
+            ax.plot(1e3 * curve.sinkage, 1e-3 * curve.pressure, color="0.75", lw=0.8,
+                    label="CMU sand, each trial" if k == 0 else None)
+        plate = chosen["plates"][d]
+        z = 1e3 * np.asarray(plate["sinkage_m"])
+        ax.errorbar(z, 1e-3 * np.asarray(plate["measured_Pa"]), yerr=1e-3 * np.asarray(plate["measured_sd_Pa"]),
+                    fmt="ks", ms=4, capsize=3, label="CMU sand, mean ± sd")
+        for row in rows:
+            if row is not chosen:
+                ax.plot(z, 1e-3 * np.asarray(row["plates"][d]["simulated_Pa"]), color="tab:blue", alpha=0.25,
+                        lw=0.8, marker=".")
+        ax.plot(z, 1e-3 * np.asarray(plate["simulated_Pa"]), color="tab:red", lw=2, marker="o",
+                label=f"DEM, sliding {chosen['friction']:g}, rolling {chosen['rolling_friction']:g}, seed 0 "
+                      f"({'the choice' if complete else 'least so far'})")
+        for k, table in enumerate(seeds):
+            dem = table[(table["source"] == "DEM") & np.isclose(table["size_m"], float(d))]
+            for label, curve in dem.groupby("label"):
+                ax.plot(1e3 * curve["sinkage_m"], 1e-3 * curve["force_N"] / (np.pi * float(d) ** 2 / 4),
+                        color="tab:red", lw=0.8, ls="--", label=f"{label}" if k < 2 else None)
+        ax.plot([], [], color="tab:blue", alpha=0.4, label="the other candidates")
+        z_max = 1e3 * max(plate["sinkage_m"]) * 1.1
+        shown = [p for row in rows for p in row["plates"][d]["simulated_Pa"]]
+        shown += [p for c in measured if f"{c.size:g}" == d for p in c.pressure[1e3 * c.sinkage <= z_max]]
+        ax.set_xlim(0, z_max)
+        ax.set_ylim(0, 1.1e-3 * np.nanmax(shown))
+        ax.set_xlabel("sinkage [mm]")
+        ax.set_ylabel("plate pressure [kPa]")
+        ax.set_title(f"{1e3 * float(d):g} mm plate, box {' × '.join(f'{v:g}' for v in chosen['plate_box_m'])} m"
+                     if "plate_box_m" in chosen else f"{1e3 * float(d):g} mm plate")
+        ax.legend(fontsize=7)
+    fig.suptitle(f"{Path(args.out).name}: objective {chosen['objective']:.3f} (plates' log-MSE "
+                 f"{chosen['plate_log_mse']:.3f}, repose {chosen['repose_deg']:.1f}° against 29°)", fontsize=10)
+    fig.tight_layout()
+    out = Path(args.png or Path(args.out) / "plates.png")
+    fig.savefig(out, dpi=120)
+    print(f"wrote {out}")
+    return 0
+
+
+def pd_read(path: Path):
+    import pandas as pd
+
+    return pd.read_csv(path)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -287,6 +360,13 @@ def main(argv=None) -> int:
     p = sub.add_parser("summary")
     p.add_argument("out", nargs="?", default="docs/soillab/calibration")
     p.set_defaults(func=summary)
+    p = sub.add_parser("figure", help="the plates of every candidate and the sand's in one figure")
+    p.add_argument("out")
+    p.add_argument("--design", choices=sorted(DESIGNS), required=True)
+    p.add_argument("--seed-plates", nargs="+", default=None, metavar="DIR",
+                   help="soil-lab plate folders of the chosen particles with other seeds, drawn beside it")
+    p.add_argument("--png", default=None, help="the figure's file (default OUT/plates.png)")
+    p.set_defaults(func=figure)
     p = sub.add_parser("choice", help="the path of the design's chosen candidate (fails until all have finished)")
     p.add_argument("out")
     p.add_argument("--design", choices=sorted(DESIGNS), required=True)

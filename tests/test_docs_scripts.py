@@ -464,3 +464,17 @@ def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monke
     assert all(e["p0_Pa"] == pytest.approx(p0, rel=1e-9) for e in extrapolation)
     text = (out / "summary.md").read_text()
     assert "Not quasi-static" in text and "not run yet" in text
+
+
+def test_the_calibration_figure_draws_the_stored_candidates_and_refuses_a_folder_without_plates(tmp_path,
+                                                                                                   measured_dir):
+    """docs/soillab_calibration.py figure on the stored EPSD grid (no DEM): the PNG is written; a --seed-plates folder
+    without a plate.csv is refused before any drawing."""
+    calibration = _load("soillab_calibration")
+    png = tmp_path / "plates.png"
+    folder = str(DOCS / "soillab" / "calibration-epsd")
+    assert calibration.main(["figure", folder, "--design", "epsd", "--png", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    assert calibration.main(["figure", folder, "--design", "epsd", "--png", str(tmp_path / "no.png"),
+                             "--seed-plates", str(tmp_path)]) == 1
+    assert not (tmp_path / "no.png").exists()

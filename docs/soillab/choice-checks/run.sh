@@ -54,6 +54,10 @@ for seed in 1 2; do
   step "plate-seed$seed" plate "${lab[@]}" --plate "${plates[@]}" --box 0.6 0.6 0.12 --seeds "$seed" \
     --checkpoint-every 10
 done
+seed_plates=("$out/plate-seed1" "$out/plate-seed2")
+[ "$cmu_sand" = 1 ] && seed_plates+=(docs/soillab/box/wide-seed1 docs/soillab/box/wide-seed2)
+"$PY" docs/soillab_calibration.py figure "${CALIBRATION:-docs/soillab/calibration-epsd-box}" \
+  --design "${DESIGN:-epsd-box}" --seed-plates "${seed_plates[@]}"   # the plates of every seed in one figure
 wheel_seeds=(1 2)
 [ "$cmu_sand" = 1 ] || wheel_seeds=(0 1 2)
 for wheel in grouser smooth; do
