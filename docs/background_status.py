@@ -4,7 +4,7 @@
   case that has a checkpoint under ``RUNS/*/cases`` its simulated time and when it was written;
 * the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective,
   then the checks on its choice (``docs/soillab/choice-checks/run.sh``): the steps finished and the last log line;
-* the validation campaigns that ``docs/validation/campaigns/signed-slip.sh`` runs: the draws each has of its target.
+* the validation campaigns that ``docs/validation/campaigns/not-worse.sh`` runs: the draws each has of its target.
 
 Reads files only (it starts and stops nothing), so it can run beside the jobs::
 
@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "signed-slip.sh"
+CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "not-worse.sh"
 CALIBRATION = ROOT / "docs" / "soillab" / "calibration-epsd-box" / "candidates"
 #: Candidates in the wide-box design (the nine grid points and the earlier surface minimum, docs/soillab/README.md).
 CALIBRATION_CANDIDATES = 10
@@ -72,13 +72,13 @@ def calibration_lines() -> list[str]:
 
 def campaign_lines() -> list[str]:
     """Each campaign of the runner script with its draws done of its target."""
-    text = CAMPAIGN_SCRIPT.read_text() if CAMPAIGN_SCRIPT.is_file() else ""
-    match = re.search(r'for spec in ((?:"[^"]+" ?)+); do', text)
+    text = CAMPAIGN_SCRIPT.read_text().replace("\\\n", " ") if CAMPAIGN_SCRIPT.is_file() else ""
+    match = re.search(r'for spec in ((?:"[^"]+"\s*)+); do', text)
     lines = ["validation campaigns (issue 36):"]
     if not match:
         return lines + [f"  no campaign list found in {CAMPAIGN_SCRIPT}"]
     for spec in re.findall(r'"([^"]+)"', match.group(1)):
-        kind, draws, seed = spec.split()
+        kind, draws, seed = spec.split()[:3]
         path = CAMPAIGN_SCRIPT.parent / f"{kind}-{seed}.jsonl"
         done = sum(1 for ln in path.read_text().splitlines() if ln.strip()) if path.is_file() else 0
         lines.append(f"  {kind}-{seed}: {done} of {draws} draws")

@@ -10,8 +10,9 @@ the current model becomes that fit, and the remaining candidates are tested agai
 A candidate passes a step when
 
 1. **evidence**: its fit lowers BIC by more than :data:`BIC_MARGIN` (strong evidence, Kass & Raftery 1995);
-2. **prediction**: its gain in held-out RMSE over the current model is positive beyond :data:`GAIN_SIGMAS`
-   bootstrap standard deviations;
+2. **prediction**: its held-out RMSE is not worse than the current model's by more than :data:`GAIN_SIGMAS`
+   bootstrap standard deviations of the gain (:func:`~.selection.prediction_holds`; until 2026-11-29 the gain had to
+   be positive beyond them, :data:`~.selection.PREDICTION_NOT_WORSE`);
 3. **physical parameter**: none of its parameters sits at a bound of its range that the data push against (a
    bound that binds: the mechanism takes all it may), and each lies on the side of its off value that the
    mechanism's own description requires (:attr:`~.extensions.Parameter.sign`);

@@ -24,7 +24,7 @@ from .discovery import (
 )
 from .measured import Measurements
 from .residuals import group_table, residuals_by_group
-from .selection import rule_digest
+from .selection import PREDICTION_NOT_WORSE, rule_digest
 
 UNITS = {"drawbar_pull": ("N", 1.0), "lateral_force": ("N", 1.0), "sinkage": ("mm", 1e3), "torque": ("N m", 1.0)}
 
@@ -234,8 +234,11 @@ def write_report(d: Discovery, data: Measurements, heldout: np.ndarray, out: str
     lines += [f"| {q} | {lof['baseline'][q]['p_value']:.2g} | {lof['final'][q]['p_value']:.2g} |" for q in d.responses]
     lines += ["", "![](residuals.png)", ""] + _group_lines(findings["residuals_by_group"])
     lines += ["## Forward selection", "",
-              f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out gain is "
-              f"positive and exceeds {GAIN_SIGMAS:g} bootstrap standard deviation(s), its parameter is inside its "
+              f"A candidate passes when ΔBIC < −{BIC_MARGIN:g} against the current model, its held-out "
+              + (f"error is not worse by more than {GAIN_SIGMAS:g} bootstrap standard deviation(s) of the gain"
+                 if PREDICTION_NOT_WORSE else
+                 f"gain is positive and exceeds {GAIN_SIGMAS:g} bootstrap standard deviation(s)")
+              + ", its parameter is inside its "
               f"physical range and of the mechanism's sign, and it removes at least {100 * MIN_EXPLAINED:.0f} % of "
               "the systematic residual. When no single mechanism passes and a systematic residual remains, the "
               f"pairs among the {PAIR_POOL} best single fits are fitted together (a look-ahead step); a pair also "
