@@ -248,3 +248,23 @@ def test_cmu_sand_is_the_calibrations_choice():
     assert chosen["density"] == material.density
     assert chosen["objective"] == pytest.approx(cmu_sand.CALIBRATION["objective"], abs=5e-4)
     assert chosen["repose_deg"] == pytest.approx(cmu_sand.CALIBRATION["repose_deg"], abs=0.05)
+
+
+def test_cmu_sand_is_the_wide_box_calibrations_choice_too():
+    """The calibration run again with every plate in the wide box (design epsd-box: the nine EPSD grid candidates and
+    the earlier surface minimum, docs/soillab/calibration-epsd-box), scored again from its stored curves, chooses the
+    same particles: cmu_sand's friction, rolling friction, law and density, with the objective its file records."""
+    import json
+    from pathlib import Path
+
+    from wheelsoil.parameters import cmu_sand
+    from wheelsoil.soillab.objective import best
+
+    folder = Path(__file__).resolve().parent.parent / "docs" / "soillab" / "calibration-epsd-box" / "candidates"
+    rows = [json.loads(p.read_text()) for p in sorted(folder.glob("*.json"))]
+    assert len(rows) == 10 and all(r["plate_box_m"] == [0.6, 0.6, 0.12] for r in rows)
+    chosen = best(rows)
+    pair, material = cmu_sand.PARTICLE_PAIR, cmu_sand.PARTICLE_MATERIAL
+    assert (chosen["friction"], chosen["rolling_friction"], chosen["rolling_model"], chosen["density"]) == (
+        pair.static_friction, pair.rolling_friction, pair.rolling_model, material.density)
+    assert chosen["objective"] == pytest.approx(cmu_sand.WIDE_BOX_CALIBRATION["objective"], abs=5e-4)
