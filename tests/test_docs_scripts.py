@@ -379,8 +379,10 @@ def test_the_background_status_reads_the_queue_log_and_the_campaign_list(tmp_pat
     import re
 
     script = status.CAMPAIGN_SCRIPT.read_text()
-    listed = [re.match(r"  (\w+)-(\d+): \d+ of (\d+) draws", ln) for ln in status.campaign_lines()[1:]]
-    assert listed and all(m and f'"{m[1]} {m[3]} {m[2]}"' in script for m in listed)
+    listed = [re.match(r"  ([\w-]+)-(\d+): \d+ of (\d+) draws", ln) for ln in status.campaign_lines()[1:]]
+    assert listed and all(m and (f'"{m[1]} {m[3]} {m[2]}"' in script or f'"{m[1]} {m[3]} {m[2]} ' in script)
+                          for m in listed)
+    assert len(listed) == len(re.findall(r'"[\w-]+ \d+ \d+[^"]*"', script))  # every campaign of the script
 
 
 def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monkeypatch, measured_dir):
