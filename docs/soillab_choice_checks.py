@@ -176,8 +176,11 @@ def wheels(out: Path, cmu_sand: bool) -> dict:
         if forces:
             f = np.array([forces[s] for s in sorted(forces)])
             entry["force_N"] = {s: forces[s].tolist() for s in sorted(forces)}
-            entry["mean_N"] = np.nanmean(f, 0).tolist()
-            entry["sd_N"] = (np.nanstd(f, 0, ddof=1) if len(f) > 1 else np.full(f.shape[1], np.nan)).tolist()
+            reached = np.isfinite(f)  # a depth no seed reached stays NaN (no warning of an empty mean)
+            total = np.where(reached, f, 0.0).sum(0)
+            entry["mean_N"] = np.where(reached.any(0), total / np.maximum(reached.sum(0), 1), np.nan).tolist()
+            entry["sd_N"] = [float(np.std(col[np.isfinite(col)], ddof=1)) if np.isfinite(col).sum() > 1 else np.nan
+                             for col in f.T]
             entry["log_mse"] = {}
             for s in sorted(forces):
                 ok = np.isfinite(forces[s]) & (forces[s] > 0) & (mean > 0)
@@ -274,7 +277,7 @@ def markdown(report: dict) -> str:
                   "|---|---|---|---|"]
         for k, z in enumerate(e["depth_mm"]):
             m, sd = e["mean_N"][k], e["sd_N"][k]
-            dem = "not reached" if not np.isfinite(m) else f"{m:.1f} ± {sd:.1f}"
+            dem = "not reached" if not np.isfinite(m) else f"{m:.1f} ± {sd:.1f}" if np.isfinite(sd) else f"{m:.1f}"
             ratio = f"{m / e['measured_N'][k]:.2f}" if np.isfinite(m) else "–"
             lines.append(f"| {z:g} | {dem} | {e['measured_N'][k]:.1f} ± {e['measured_sd_N'][k]:.1f} "
                          f"({e['measured_trials'][k]}) | {ratio} |")
