@@ -1,0 +1,60 @@
+"""Which sphere sets the neighbour-rebuild rate of a coupled run: the CMU twin's protocol, then the fastest spheres.
+
+The soil's neighbour list is rebuilt whenever any sphere has moved half the skin since the last build, so one fast
+grain sets the whole bed's rebuild rate. This runs ``cmu-grouser`` (with ``--set`` overrides, e.g. finer particles)
+through its protocol with a short drive, then steps on in chunks and prints, per chunk, the rebuilds so far and the
+fastest sphere (speed, position, radius) and how many move faster than 0.5 and 1 m/s::
+
+    python benchmarks/experiments/fast_grains.py --set soil.diameter_min=0.003072 soil.diameter_max=0.004608 \\
+        --chunks 12 --steps 5
+
+(2026-11-29, benchmarks/README.md: at about 100,000 spheres a grain rising at 4.0 m/s beside the wheel forced a
+rebuild every five steps; at the twin's 21,485, a grain falling inside the open drum at 0.3 m/s, one every 70.)
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="the case's settings (wheelsoil run --set)")
+    ap.add_argument("--drive-time", type=float, default=0.3, help="the protocol's drive [s] (default 0.3)")
+    ap.add_argument("--chunks", type=int, default=20, help="chunks stepped after the protocol (default 20)")
+    ap.add_argument("--steps", type=int, default=10, help="DEM steps a chunk (default 10)")
+    args = ap.parse_args(argv)
+
+    from wheelsoil import runtime
+
+    runtime.init()
+    from wheelsoil.cases import build
+    from wheelsoil.cases.schema import load_case
+    from wheelsoil.coupling.testbed import Testbed
+    from wheelsoil.granular import prepare_bed
+
+    case = load_case("cmu-grouser", [*args.set, f"test.drive_time={args.drive_time!r}", "test.stop_when_steady=false",
+                                     "output.average_time=0.1", "output.render=false"])
+    bed = prepare_bed(build.bed_spec(case))
+    bench = Testbed(bed, build.wheel_geometry(case), build.testbed_spec(case))
+    t0 = time.perf_counter()
+    bench.run()
+    scene = bench.scene
+    print(f"protocol {time.perf_counter() - t0:.0f} s; {scene.n_particles} spheres, skin "
+          f"{1e3 * scene.device.neighbor_list.skin:.3f} mm, DEM step {scene.time_step:.3e} s", flush=True)
+    start = scene.neighbor_rebuilds
+    for k in range(args.chunks):
+        scene.step(args.steps)
+        speed = np.linalg.norm(scene.velocities, axis=1)
+        i = int(np.argmax(speed))
+        print(f"chunk {k}: rebuilds {scene.neighbor_rebuilds - start}, fastest {speed[i]:.3f} m/s at "
+              f"{np.round(1e3 * scene.positions[i], 1)} mm (radius {1e3 * scene.radii[i]:.2f} mm), "
+              f"{int((speed > 0.5).sum())} above 0.5 m/s, {int((speed > 1.0).sum())} above 1 m/s", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
