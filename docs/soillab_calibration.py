@@ -250,21 +250,33 @@ def summary(args) -> int:
     return 0
 
 
-def choice(args) -> int:
-    """Print the path of the design's choice by its rule (the least objective, every candidate scored again from its
-    stored curves); refuse while any of the design's candidates has not finished."""
-    folder = Path(args.out) / "candidates"
-    names = [candidate_name(mu, mu_r, pour, law) for mu, mu_r, pour, _, law in DESIGNS[args.design]]
-    missing = [name for name in names if not (folder / f"{name}.json").is_file()]
+def design_choice(out, design: str) -> tuple[Path, dict]:
+    """The file and row of ``design``'s choice in ``out`` by its rule (the least objective, every candidate scored again
+    from its stored curves); refused, naming them, while any of the design's candidates has not finished."""
+    from wheelsoil.errors import WheelsoilInputError
+
+    folder = Path(out) / "candidates"
+    paths = [folder / f"{candidate_name(mu, mu_r, pour, law)}.json" for mu, mu_r, pour, _, law in DESIGNS[design]]
+    missing = [p.stem for p in paths if not p.is_file()]
     if missing:
-        print(f"{args.out}: design {args.design!r} has {len(names) - len(missing)} of {len(names)} candidates; "
-              f"not finished: {', '.join(missing)}", file=sys.stderr)
+        raise WheelsoilInputError(f"{out}: design {design!r} has {len(paths) - len(missing)} of {len(paths)} "
+                                  f"candidates; not finished: {', '.join(missing)}")
+    rows = [score(json.loads(p.read_text())) for p in paths]
+    chosen = objective_best(rows)
+    k = next(k for k, r in enumerate(rows) if r["objective"] == chosen["objective"])
+    return paths[k], rows[k]
+
+
+def choice(args) -> int:
+    """Print the path of the design's choice (:func:`design_choice`); refuse while any candidate has not finished."""
+    from wheelsoil.errors import WheelsoilInputError
+
+    try:
+        path, _ = design_choice(args.out, args.design)
+    except WheelsoilInputError as exc:
+        print(exc, file=sys.stderr)
         return 1
-    rows = {name: json.loads((folder / f"{name}.json").read_text()) for name in names}
-    chosen = objective_best(list(rows.values()))
-    name = candidate_name(chosen["friction"], chosen["rolling_friction"], chosen.get("pour_friction_factor", 1.0),
-                          chosen["rolling_model"])
-    print(folder / f"{name}.json")
+    print(path)
     return 0
 
 
@@ -274,6 +286,8 @@ def figure(args) -> int:
     sinkages, every candidate of the folder faint and the least objective bold (the design's choice once all of its
     candidates have finished; "least so far" before), with ``--seed-plates``' curves beside it: ``wheelsoil soil-lab
     plate`` folders of other seeds, which must be of the chosen particles (their files do not say)."""
+    import pandas as pd
+
     from wheelsoil import soillab
     from wheelsoil.plotting import pyplot
 
@@ -291,7 +305,7 @@ def figure(args) -> int:
         if not path.is_file():
             print(f"--seed-plates {folder}: no plate.csv", file=sys.stderr)
             return 1
-        seeds.append(pd_read(path))
+        seeds.append(pd.read_csv(path))
     plt = pyplot()
     diameters = sorted(chosen["plates"], key=float)
     fig, axes = plt.subplots(1, len(diameters), figsize=(5.2 * len(diameters), 4.2), squeeze=False)
@@ -304,7 +318,7 @@ def figure(args) -> int:
         ax.errorbar(z, 1e-3 * np.asarray(plate["measured_Pa"]), yerr=1e-3 * np.asarray(plate["measured_sd_Pa"]),
                     fmt="ks", ms=4, capsize=3, label="CMU sand, mean ± sd")
         for row in rows:
-            if row is not chosen:
+            if row["objective"] != chosen["objective"]:
                 ax.plot(z, 1e-3 * np.asarray(row["plates"][d]["simulated_Pa"]), color="tab:blue", alpha=0.25,
                         lw=0.8, marker=".")
         ax.plot(z, 1e-3 * np.asarray(plate["simulated_Pa"]), color="tab:red", lw=2, marker="o",
@@ -333,12 +347,6 @@ def figure(args) -> int:
     fig.savefig(out, dpi=120)
     print(f"wrote {out}")
     return 0
-
-
-def pd_read(path: Path):
-    import pandas as pd
-
-    return pd.read_csv(path)
 
 
 def main(argv=None) -> int:

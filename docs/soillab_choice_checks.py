@@ -40,20 +40,14 @@ WHEEL_DEPTHS_MM = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
 def chosen_candidate() -> tuple[Path, dict]:
     """The calibration's choice by its rule (``docs/soillab_calibration.py choice``) and its row."""
     sys.path.insert(0, str(DOCS))
-    from soillab_calibration import DESIGNS, candidate_name
+    from soillab_calibration import design_choice
 
-    from wheelsoil.soillab.objective import best
+    from wheelsoil.errors import WheelsoilInputError
 
-    paths = [CALIBRATION / "candidates" / f"{candidate_name(mu, mu_r, pour, law)}.json"
-             for mu, mu_r, pour, _, law in DESIGNS[DESIGN]]
-    missing = [p.name for p in paths if not p.is_file()]
-    if missing:
-        raise SystemExit(f"{CALIBRATION}: the calibration has not finished ({', '.join(missing)} missing)")
-    rows = {p: json.loads(p.read_text()) for p in paths}
-    chosen = best(list(rows.values()))
-    path = next(p for p, r in rows.items() if (r["friction"], r["rolling_friction"]) == (chosen["friction"],
-                                                                                        chosen["rolling_friction"]))
-    return path, rows[path]
+    try:
+        return design_choice(CALIBRATION, DESIGN)
+    except WheelsoilInputError as exc:
+        raise SystemExit(str(exc)) from None
 
 
 def is_cmu_sand(row: dict) -> bool:
@@ -311,7 +305,8 @@ def build(out: Path) -> dict:
                        "rolling_friction": row["rolling_friction"], "density": row["density"],
                        "rolling_model": row["rolling_model"], "cmu_sand": cmu_sand},
             "repose": rep, "shear_speed": shear_speed(out), "plates": plate, "runner_up": runner_up(row),
-            "wheels": wheels(out, cmu_sand), "scale": scale(out, plate_pressures(out, row, cmu_sand), row)}
+            "wheels": wheels(out, cmu_sand),
+            "scale": scale(out, {s: v["pressure_Pa"] for s, v in plate["per_seed"].items()}, row)}
 
 
 def main(argv=None) -> int:
