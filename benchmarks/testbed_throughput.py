@@ -19,7 +19,8 @@ and a measured extrapolation to seed-004 scale (388,026 particles, the full-reso
 Run:  python -m wheelsoil.benchmarks.testbed_throughput [--out benchmarks/results/testbed.json] [--arch cuda]
       python -m wheelsoil.benchmarks.testbed_throughput --cmu --out benchmarks/results/testbed-cmu.json
         (only the CMU twin's scale: part 1 on ``cmu-grouser``; ``--set KEY=VALUE ...`` changes the case, e.g. the
-        particles' size for the rig at about 100,000 particles)
+        particles' size for the rig at about 100,000 particles; ``--half-skin-too`` also times the half-skin
+        neighbour-rebuild rule in the same rounds)
       python -m wheelsoil.benchmarks.testbed_throughput --compare-pinning 3 --drive-time 0.05
         (only the A/B of pinned and unpinned worker threads, :mod:`wheelsoil.threads`, in alternating processes)
 """
@@ -32,6 +33,7 @@ import statistics
 import subprocess
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from wheelsoil import runtime
@@ -63,11 +65,12 @@ COUPLED_PARTS = {"smoke": "smoke-1g-steer", "cmu": "cmu-grouser"}
 
 
 def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"], rounds: int = 6,
-               overrides: tuple[str, ...] = ()) -> dict:
+               overrides: tuple[str, ...] = (), half_skin_too: bool = False) -> dict:
     """The whole protocol of ``preset`` with a short drive, then ``steps`` timed DEM steps of steady driving by part,
     alternating in ``rounds`` chunks with as many steps of the same bed alone (module docstring, part 1; ``preset``
     cmu-grouser: the CMU twin's rigid wheel on its calibrated sand, issue 37 item 2). ``overrides``: the case's
-    ``KEY=VALUE`` settings (as ``wheelsoil run --set``), e.g. finer particles for the rig at its own scale."""
+    ``KEY=VALUE`` settings (as ``wheelsoil run --set``), e.g. finer particles for the rig at its own scale;
+    ``half_skin_too``: time the half-skin rebuild rule too, in the same rounds (:func:`_coupled_against_soil`)."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed
@@ -100,15 +103,53 @@ def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS[
         "fe_time_step_s": info["fe_time_step"],
         "fe_substeps_per_dem_step": info["fe_substeps"] / info["dem_steps"],
     }
-    out.update(_coupled_against_soil(bench, bed, case, steps, rounds, arch))
+    out.update(_coupled_against_soil(bench, bed, case, steps, rounds, arch, half_skin_too))
     return out
 
 
-def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch) -> dict:
+#: The coupled step's timed parts (wrapped methods of the wheel contact), each with its CPU time beside.
+_PARTS = ("wheel", "contact", "rebuild", "wheel_cpu", "contact_cpu", "rebuild_cpu")
+
+
+@dataclass
+class _Tally:
+    """What the coupled steps under one rebuild rule took, summed over the rounds."""
+
+    seconds: float = 0.0
+    cpu: float = 0.0
+    wheel_rebuilds: int = 0
+    dem_rebuilds: int = 0
+    contacts: int = 0
+    parts: dict = field(default_factory=lambda: dict.fromkeys(_PARTS, 0.0))
+    per_round: list = field(default_factory=list)
+
+    def step(self, bench, blocks: int, totals: dict) -> float:
+        """``blocks`` of 10 coupled steps from a fresh neighbour rebuild, added to the tally; their wall time [s]."""
+        c, scene = bench.contact, bench.scene
+        scene.request_neighbor_rebuild()  # each round starts from a rebuild under its own rule
+        r0, d0, before = c.rebuilds, scene.neighbor_rebuilds, dict(totals)
+        t0, cpu0 = time.perf_counter(), time.process_time()
+        for _ in range(blocks):
+            scene.step(10)
+            self.contacts += c.contact_count
+        seconds = time.perf_counter() - t0
+        self.seconds += seconds
+        self.cpu += time.process_time() - cpu0
+        self.wheel_rebuilds += c.rebuilds - r0
+        self.dem_rebuilds += scene.neighbor_rebuilds - d0
+        for key in _PARTS:
+            self.parts[key] += totals[key] - before[key]
+        return seconds
+
+
+def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_skin_too: bool = False) -> dict:
     """``steps`` DEM steps of the running testbed ``bench``, timed by part, alternating in ``rounds`` chunks with as
-    many steps of its bed ``bed`` alone (:func:`smoke_part`)."""
+    many steps of its bed ``bed`` alone (:func:`smoke_part`). ``half_skin_too``: each round also steps the testbed as
+    many steps under the half-skin rule (:class:`~wheelsoil.granular.interaction.HalfSkinRule`), timed apart
+    (``half_skin_*`` figures)."""
     from wheelsoil.cases import build
     from wheelsoil.coupling.rig import soil_headroom
+    from wheelsoil.granular.interaction import HalfSkinRule
 
     # where the time of one coupled step goes, in steady driving, against the soil alone: the same bed in its own bin
     # (periodic along x where the testbed holds a moving patch's ends instead) at the same step and in the same
@@ -123,59 +164,72 @@ def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch) -> di
     _timed(c, "after_drift", totals, "wheel")
     _timed(c, "add_forces", totals, "contact")
     _timed(c, "_rebuild", totals, "rebuild")
-    rebuilds0, dem_rebuilds0 = c.rebuilds, scene.neighbor_rebuilds
     blocks = max(1, steps // (10 * rounds))  # blocks of 10 steps per round
-    contacts = 0
-    total = cpu = soil_total = soil_cpu = 0.0
-    per_round = []
+    today, half, rule = _Tally(), _Tally(), HalfSkinRule()
+    soil_total = soil_cpu = 0.0
     for _ in range(rounds):
-        t0, cpu0 = time.perf_counter(), time.process_time()
-        for _ in range(blocks):
-            scene.step(10)
-            contacts += c.contact_count
-        coupled_round = time.perf_counter() - t0
-        total += coupled_round
-        cpu += time.process_time() - cpu0
+        if half_skin_too:
+            scene.interactions.append(rule)
+            half_round = half.step(bench, blocks, totals)
+            scene.interactions.remove(rule)
+        seconds = today.step(bench, blocks, totals)
         t0, cpu0 = time.perf_counter(), time.process_time()
         soil.step(10 * blocks)
         soil_round = time.perf_counter() - t0
         soil_total += soil_round
         soil_cpu += time.process_time() - cpu0
-        per_round.append(coupled_round / soil_round)
-    n = 10 * blocks * rounds
-    contact_eval = totals["contact"] - totals["rebuild"]
-    contact_eval_cpu = totals["contact_cpu"] - totals["rebuild_cpu"]
+        today.per_round.append(seconds / soil_round)
+        if half_skin_too:
+            half.per_round.append(half_round / soil_round)
+    out = _figures(today, 10 * blocks * rounds, rounds, soil_total, soil_cpu)
+    if half_skin_too:
+        out.update({
+            "half_skin_ms_per_step": 1e3 * half.seconds / out["timed_steps"],
+            "half_skin_dem_neighbor_rebuilds": half.dem_rebuilds,
+            "half_skin_coupled_over_soil_alone": half.seconds / soil_total,
+            "half_skin_coupled_over_soil_alone_per_round": half.per_round,
+            "half_skin_over_allowance": half.seconds / today.seconds,
+        })
+    return out
+
+
+def _figures(t: _Tally, n: int, rounds: int, soil_total: float, soil_cpu: float) -> dict:
+    """The figures of :func:`_coupled_against_soil` from the tally of ``n`` coupled steps and the soil alone's wall and
+    CPU time [s] over as many."""
+    parts = t.parts
+    contact_eval = parts["contact"] - parts["rebuild"]
+    contact_eval_cpu = parts["contact_cpu"] - parts["rebuild_cpu"]
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return {
         "timed_steps": n,
         "rounds": rounds,
-        "ms_per_step": 1e3 * total / n,
-        "cores_busy": cpu / total,  # CPU time of all threads / wall time over the timed steps
-        "ms_per_step_soil": 1e3 * (total - totals["wheel"] - totals["contact"]) / n,
-        "ms_per_step_wheel": 1e3 * totals["wheel"] / n,
+        "ms_per_step": 1e3 * t.seconds / n,
+        "cores_busy": t.cpu / t.seconds,  # CPU time of all threads / wall time over the timed steps
+        "ms_per_step_soil": 1e3 * (t.seconds - parts["wheel"] - parts["contact"]) / n,
+        "ms_per_step_wheel": 1e3 * parts["wheel"] / n,
         "ms_per_step_contact_evaluation": 1e3 * contact_eval / n,
-        "ms_per_step_contact_rebuild": 1e3 * totals["rebuild"] / n,
+        "ms_per_step_contact_rebuild": 1e3 * parts["rebuild"] / n,
         # CPU time of all threads per DEM step, by part (the soil: the rest of the step)
-        "cpu_ms_per_step": 1e3 * cpu / n,
-        "cpu_ms_per_step_soil": 1e3 * (cpu - totals["wheel_cpu"] - totals["contact_cpu"]) / n,
-        "cpu_ms_per_step_wheel": 1e3 * totals["wheel_cpu"] / n,
+        "cpu_ms_per_step": 1e3 * t.cpu / n,
+        "cpu_ms_per_step_soil": 1e3 * (t.cpu - parts["wheel_cpu"] - parts["contact_cpu"]) / n,
+        "cpu_ms_per_step_wheel": 1e3 * parts["wheel_cpu"] / n,
         "cpu_ms_per_step_contact_evaluation": 1e3 * contact_eval_cpu / n,
-        "cpu_ms_per_step_contact_rebuild": 1e3 * totals["rebuild_cpu"] / n,
-        "contact_rebuilds": c.rebuilds - rebuilds0,
-        "dem_neighbor_rebuilds": scene.neighbor_rebuilds - dem_rebuilds0,
-        "mean_wheel_contacts": contacts / (blocks * rounds),
+        "cpu_ms_per_step_contact_rebuild": 1e3 * parts["rebuild_cpu"] / n,
+        "contact_rebuilds": t.wheel_rebuilds,
+        "dem_neighbor_rebuilds": t.dem_rebuilds,
+        "mean_wheel_contacts": t.contacts / (n // 10),
         "peak_rss_mib": own_peak_rss_mib(),
         "ms_per_step_soil_alone": 1e3 * soil_total / n,
         "cpu_ms_per_step_soil_alone": 1e3 * soil_cpu / n,
         "soil_alone_cores_busy": soil_cpu / soil_total,
-        "coupled_over_soil_alone": total / soil_total,
-        "coupled_over_soil_alone_per_round": per_round,
-        "coupled_over_soil_alone_median": statistics.median(per_round),
+        "coupled_over_soil_alone": t.seconds / soil_total,
+        "coupled_over_soil_alone_per_round": t.per_round,
+        "coupled_over_soil_alone_median": statistics.median(t.per_round),
         "cores": cores,
         # the ratio if the coupled step's CPU work were spread over every core with none idle and the soil alone
         # kept its measured wall time: the floor that scheduling alone cannot go below, for the present cost of
         # each part (CPU time counts work done, not waiting: Taichi's idle workers sleep)
-        "coupled_over_soil_alone_all_cores_busy": cpu / cores / soil_total,
+        "coupled_over_soil_alone_all_cores_busy": t.cpu / cores / soil_total,
     }
 
 
@@ -316,7 +370,7 @@ def cmu_scale(args) -> int:
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
     cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"], args.rounds,
-                                     tuple(args.set))
+                                     tuple(args.set), args.half_skin_too)
     print(f"CMU scale ({cmu['case']}): {cmu['particles']} particles, rigid wheel of {cmu['fe_elements']} elements; "
           f"{cmu['wall_seconds_per_simulated_second']:.0f} s wall per simulated s over the protocol; per DEM step "
           f"{cmu['ms_per_step']:.2f} ms = soil {cmu['ms_per_step_soil']:.2f} + wheel {cmu['ms_per_step_wheel']:.2f} + "
@@ -326,7 +380,13 @@ def cmu_scale(args) -> int:
           f"in all, median of {cmu['rounds']} alternating rounds {cmu['coupled_over_soil_alone_median']:.2f} ("
           f"{', '.join(f'{x:.2f}' for x in cmu['coupled_over_soil_alone_per_round'])}) (goal <= 1.2); "
           f"CPU per step {cmu['cpu_ms_per_step']:.2f} ms, the bed alone "
-          f"{cmu['cpu_ms_per_step_soil_alone']:.2f}; peak RSS {cmu['peak_rss_mib']:.0f} MiB", flush=True)
+          f"{cmu['cpu_ms_per_step_soil_alone']:.2f}; peak RSS {cmu['peak_rss_mib']:.0f} MiB; "
+          f"{cmu['dem_neighbor_rebuilds']} neighbour rebuilds", flush=True)
+    if args.half_skin_too:
+        print(f"the half-skin rule in the same rounds: {cmu['half_skin_ms_per_step']:.2f} ms per step, "
+              f"{cmu['half_skin_dem_neighbor_rebuilds']} neighbour rebuilds, coupled / soil alone "
+              f"{cmu['half_skin_coupled_over_soil_alone']:.2f}; half skin / allowance "
+              f"{cmu['half_skin_over_allowance']:.2f}", flush=True)
     return _write_report(args.out, report)
 
 
@@ -347,10 +407,15 @@ def main(argv=None) -> int:
     ap.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
                     help="with --cmu: the case's settings as in wheelsoil run --set, e.g. soil.diameter_min=0.003072 "
                          "soil.diameter_max=0.004608 for the rig at about 100,000 particles")
+    ap.add_argument("--half-skin-too", action="store_true",
+                    help="with --cmu: each round also steps the testbed under the half-skin rebuild rule (every "
+                         "sphere's allowance half the skin, as before the per-sphere allowance), timed apart")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.set and not args.cmu:
         ap.error("--set applies to the CMU part only (--cmu)")
+    if args.half_skin_too and not args.cmu:
+        ap.error("--half-skin-too applies to the CMU part only (--cmu)")
     if args.rounds < 1 or args.steps < 10 * args.rounds:
         ap.error(f"--rounds {args.rounds} and --steps {args.steps}: give at least one round and 10 steps per round")
     if args.part:

@@ -39,7 +39,14 @@ half thickness h (the contact surface lies h either side of the facet's mid-surf
   ahead at its velocity to the mean of the sub-steps' positions (:func:`.kernels.node_load`): holding the force
   constant instead lets light nodes (a coarse grouser's tip) that several loaded spheres press on run unstable at
   the DEM step, and linearising about the evaluated position itself gives a node moving into the soil more than f
-  on average, so the wheel did not carry the force the soil reported (issue 35).
+  on average, so the wheel did not carry the force the soil reported (issue 35);
+* candidates: the spheres within reach of each facet plus a margin for the spheres' motion (:data:`SPHERE_SKINS` of
+  the scene's skin) and the wheel's (``wheel_skin``), built only in a step in which the scene rebuilt its neighbour
+  lists: when they need rebuilding for any other reason (the wheel has moved ``wheel_skin``, a restore, new spheres),
+  they are rebuilt at once and the scene is asked to rebuild at the next step
+  (:meth:`~wheelsoil.granular.Scene.request_neighbor_rebuild`), where they follow. So a sphere has moved from where
+  the candidates saw it no more than since the scene's last rebuild, which :meth:`WheelContact.displacement_cap`
+  bounds by the candidates' margin for it.
 """
 
 from __future__ import annotations
@@ -83,6 +90,26 @@ def anchor_lead(interval: float, substeps: int) -> float:
     return interval * (substeps - 1) / (2 * substeps)
 
 
+def _grown(arrays: dict, name: str, dtype, size: int, shape_tail: tuple = ()):
+    """``arrays[name]``, a scratch ndarray of at least ``size`` rows (replaced by one 25 % larger when too small)."""
+    arr = arrays.get(name)
+    if arr is None or arr.shape[0] < size:
+        rows = max(16, int(size * 1.25) + 16)
+        if dtype is vec3:
+            arr = ti.Vector.ndarray(3, ti.f64, shape=(rows,) + shape_tail)
+        else:
+            arr = ti.ndarray(dtype, shape=(rows,) + shape_tail)
+        arrays[name] = arr
+    return arr
+
+
+#: The candidates' margin for the spheres' motion between two rebuilds, in the scene's skins: the most a sphere may
+#: move before the scene rebuilds (a sphere clear of its neighbours may otherwise move up to half its clearance;
+#: :func:`wheelsoil.granular.neighbors.displacement_allowance`). Two skins: four times the plain Verlet half skin,
+#: for a margin 6/5 of the former one (skin + 4 skins of the wheel's own).
+SPHERE_SKINS = 2.0
+
+
 class WheelContact(Interaction):
     """Contact between the spheres of a scene and the surface facets of a wheel structure.
 
@@ -96,7 +123,7 @@ class WheelContact(Interaction):
     health_every: steps between the structure's health checks.
     wheel_skin: how far [m] the wheel's surface may move before the candidate lists are rebuilt
         (default: four times the scene's skin); candidates are kept within the sphere's reach plus
-        the scene's skin plus this.
+        :data:`SPHERE_SKINS` of the scene's skin (the spheres' motion) plus this (module docstring, *candidates*).
     """
 
     def __init__(
@@ -144,23 +171,15 @@ class WheelContact(Interaction):
 
     # ------------------------------------------------------------------ buffers
     def _buffer(self, name: str, dtype, size: int, *, shape_tail: tuple = ()):
-        """A scratch ndarray of at least ``size`` rows (grown by 25 % when too small)."""
-        arr = self._arrays.get(name)
-        if arr is None or arr.shape[0] < size:
-            rows = max(16, int(size * 1.25) + 16)
-            if dtype is vec3:
-                arr = ti.Vector.ndarray(3, ti.f64, shape=(rows,) + shape_tail)
-            else:
-                arr = ti.ndarray(dtype, shape=(rows,) + shape_tail)
-            self._arrays[name] = arr
-        return arr
+        """A scratch ndarray of at least ``size`` rows (:func:`_grown`)."""
+        return _grown(self._arrays, name, dtype, size, shape_tail)
 
     def _attach(self, scene: Scene) -> None:
         """(Re)allocate the per-particle arrays and the facet grid for ``scene``'s particles."""
         n = scene.n_particles
         radii = scene.radii
         self.wheel_skin = self._wheel_skin_request or 4.0 * scene.skin
-        self.skin = scene.skin + self.wheel_skin  # candidate margin
+        self.skin = self.displacement_cap(scene) + self.wheel_skin  # candidate margin
         self.r_max = float(radii.max())
         a = self._arrays
         a.clear()
@@ -227,15 +246,22 @@ class WheelContact(Interaction):
         """Evaluate every sphere--wheel contact at the current positions (see the module docstring)."""
         if self._scene_key != (id(scene), scene.n_particles):
             self._attach(scene)
-        if self._need_rebuild or scene.neighbor_rebuilds != self._seen_rebuilds:
+        scene_rebuilt = scene.neighbor_rebuilds != self._seen_rebuilds
+        if self._need_rebuild or scene_rebuilt:
             self._rebuild(scene)
+            if not scene_rebuilt:  # built off the scene's Verlet reference: both again at the next step
+                scene.request_neighbor_rebuild()
         self._launch_contacts(dt)
         # two scalar reads (~25 us) rather than to_numpy (~100 us: a copy kernel and an array)
         self._n_contacts = int(self._stats[1])
         # rebuild before the wheel's surface has moved its skin (less a margin for one more step)
         if self._stats[0] > (0.8 * self.wheel_skin) ** 2:
-            self._need_rebuild = True
+            scene.request_neighbor_rebuild()
         return self._n_contacts
+
+    def displacement_cap(self, scene: Scene) -> float:
+        """The most [m] a sphere may move between the scene's rebuilds: :data:`SPHERE_SKINS` of its skin."""
+        return SPHERE_SKINS * scene.skin
 
     def _launch_contacts(self, dt: float) -> None:
         """One evaluation of every contact (:func:`.kernels.wheel_contacts`, as a compute graph); its array

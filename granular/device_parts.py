@@ -52,7 +52,7 @@ class DeviceParts:
         # the pair list the first build carries the history from (the host copy, if any)
         pairs = (PairList.from_history(n, h.pair_i, h.pair_j, h.pair_xi, h.pair_roll) if h is not None
                  else PairList.allocate(n, 1))
-        neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs)
+        neighbor_list = NeighborList(n, grid, skin, row_width(r_min, r_max, skin), pairs, r_max)
         wall_arrays = WallArrays.upload(walls, material, n, *((h.xi_wall, h.roll_wall) if h is not None
                                                               else (None, None)))
         params = ContactParameters.of(material, pair)

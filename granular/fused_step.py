@@ -15,7 +15,7 @@ the partner loop of :func:`.forces.contact_forces`, then, per particle,
 with the same Taichi functions and in the same order as the separate kernels, so the trajectory is the
 velocity-Verlet one. It saves two passes over the particle arrays and two kernel launches per step
 (each parallel loop costs Taichi's CPU backend ~50 us of thread wake-up); :meth:`wheelsoil.granular.Scene.step`
-uses it whenever it can, launched as a compute graph (:data:`contact_step_graph`), which sets its 25
+uses it whenever it can, launched as a compute graph (:data:`contact_step_graph`), which sets its 26
 array arguments in C++ instead of Python (~0.1 ms instead of ~0.3 ms per step).
 """
 
@@ -71,6 +71,7 @@ def contact_step(
     gz: ti.f64,
     drift: ti.i32,
     x_ref: nd_vec3,
+    allowance_inv2: nd_f64,
     x_r: nd_vec4,
     v_m: nd_vec4,
     w_i: nd_vec4,
@@ -79,8 +80,9 @@ def contact_step(
     """Contact forces at the current positions (read from the contact view ``x_r``, ``v_m``,
     ``w_i``), the step's second half kick and, if ``drift`` != 0, the next step's first half kick and
     drift, which also refresh the contact view. Writes the number of contacts to ``result[0]`` and
-    the largest squared displacement since the last neighbour-list build [m^2] (0 without drift) to
-    ``result[1]`` (it runs as a compute graph, :class:`wheelsoil.graph_launch.GraphKernel`, which
+    the largest squared displacement since the last neighbour-list build over the sphere's squared allowance
+    (``allowance_inv2`` [1/m^2], :func:`.neighbors.displacement_allowance`; 0 without drift; a rebuild is due
+    above 1) to ``result[1]`` (it runs as a compute graph, :class:`wheelsoil.graph_launch.GraphKernel`, which
     cannot return values)."""
     n_contacts = 0
     for i in x:
@@ -106,7 +108,7 @@ def contact_step(
             half_kick(j, v, omega, force, torque, mass, inertia, mobile, gravity, half)
             x[j] += dt * v[j]
             write_contact_view(j, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
-            ti.atomic_max(largest, (x[j] - x_ref[j]).norm_sqr())
+            ti.atomic_max(largest, (x[j] - x_ref[j]).norm_sqr() * allowance_inv2[j])
     result[0] = n_contacts
     result[1] = largest
 

@@ -91,6 +91,7 @@ def kick_drift(
     gz: ti.f64,
     dt: ti.f64,
     x_ref: nd_vec3,
+    allowance_inv2: nd_f64,
     radius: nd_f64,
     x_r: nd_vec4,
     v_m: nd_vec4,
@@ -98,10 +99,11 @@ def kick_drift(
     result: nd_f64,
 ):
     """Half kick of v and omega, full drift of x, and the contact view of the new state; writes the
-    largest squared displacement since the last neighbour-list build [m^2] to ``result[0]`` (it runs
-    as a compute graph, :data:`kick_drift_graph`, which cannot return values). Gravity (gx, gy, gz)
-    [m/s^2] comes as three scalars: a vector argument costs Taichi ~40 us per launch on the Python
-    side."""
+    largest squared displacement since the last neighbour-list build over the sphere's squared allowance
+    (``allowance_inv2`` [1/m^2], :func:`.neighbors.displacement_allowance`; a rebuild is due above 1) to
+    ``result[0]`` (it runs as a compute graph, :data:`kick_drift_graph`, which cannot return values).
+    Gravity (gx, gy, gz) [m/s^2] comes as three scalars: a vector argument costs Taichi ~40 us per launch on
+    the Python side."""
     half = 0.5 * dt
     gravity = vec3(gx, gy, gz)
     largest = 0.0
@@ -109,7 +111,7 @@ def kick_drift(
         half_kick(i, v, omega, force, torque, mass, inertia, mobile, gravity, half)
         x[i] += dt * v[i]
         write_contact_view(i, x, v, omega, radius, mass, inertia, x_r, v_m, w_i)
-        ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr())
+        ti.atomic_max(largest, (x[i] - x_ref[i]).norm_sqr() * allowance_inv2[i])
     result[0] = largest
 
 

@@ -15,6 +15,12 @@ class Interaction:
       The one-launch step that follows adds them to the sphere--sphere and sphere--wall forces
       (:mod:`.fused_step`).
 
+    A body that keeps candidate lists of spheres near it, built with a margin for the spheres' motion, defines
+    ``displacement_cap(scene) -> float``: that margin [m], the most a sphere may move between two of the scene's
+    neighbour rebuilds (:meth:`~.scene.Scene.displacement_cap`; otherwise a sphere clear of its neighbours may move
+    up to half its clearance). It builds its lists in a step in which the scene rebuilt (``scene.neighbor_rebuilds``
+    changed), or else calls ``scene.request_neighbor_rebuild()`` so that the next step does.
+
     An optional ``renumber(scene, old_of_new)`` hears that sphere k is now the former sphere ``old_of_new[k]``
     (-1: a new one) after spheres were added or removed.
 
@@ -30,3 +36,20 @@ class Interaction:
     def add_forces(self, scene, dt: float) -> int:  # pragma: no cover - protocol
         """Add the contact forces and torques at t + dt to the scene's external arrays; the number of contacts."""
         return 0
+
+
+class HalfSkinRule(Interaction):
+    """No body, no force: caps every sphere's displacement allowance at half the skin, the plain Verlet test (a
+    rebuild once any sphere has moved half the skin) that the neighbour lists used before each sphere had its own
+    allowance (:func:`.neighbors.displacement_allowance`). The trajectory is the same either way; this is for
+    comparing the rebuild counts and costs in one run (``scene.interactions.append(HalfSkinRule())``)."""
+
+    def after_drift(self, scene, dt: float) -> None:
+        pass
+
+    def add_forces(self, scene, dt: float) -> int:
+        return 0
+
+    def displacement_cap(self, scene) -> float:
+        """Half the scene's skin [m]."""
+        return 0.5 * scene.skin

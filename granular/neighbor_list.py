@@ -7,6 +7,7 @@ allocates nothing once sizes settle), lays out the partner slots the force pass 
 within reach of each sphere.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,14 +80,26 @@ def row_width(r_min: float, r_max: float, skin: float) -> int:
 
 
 class NeighborList:
-    """Cells, rows and the pair list of ``n`` spheres on ``grid`` (periodic along x where the grid is) with Verlet
-    ``skin`` [m]; ``pairs`` holds the history the first build carries over."""
+    """Cells, rows and the pair list of ``n`` spheres of radius up to ``r_max`` [m] on ``grid`` (periodic along x
+    where the grid is) with Verlet ``skin`` [m]; ``pairs`` holds the history the first build carries over.
+
+    Each rebuild also gives every sphere its displacement allowance until the next one
+    (:func:`.neighbors.displacement_allowance`, from its clearance to whatever it does not list): ``allowance_inv2``
+    holds 1 / a_i^2 [1/m^2], and the steps ask for a rebuild once some sphere's |x_i - x_ref_i|^2 / a_i^2 exceeds 1.
+    """
 
     #: Widest row allowed: more partners with higher indices than this means an unreasonable size ratio or skin.
     MAX_ROW = 4096
 
-    def __init__(self, n: int, grid: UniformGrid, skin: float, width: int, pairs: PairList) -> None:
-        self.n, self.grid, self.skin = n, grid, float(skin)
+    def __init__(self, n: int, grid: UniformGrid, skin: float, width: int, pairs: PairList, r_max: float) -> None:
+        self.n, self.grid, self.skin, self.r_max = n, grid, float(skin), float(r_max)
+        #: each sphere's clearance at the last rebuild [m] and its displacement allowance as 1 / a^2 [1/m^2];
+        #: until the first rebuild, an allowance of 1e-15 m (any drift asks for one)
+        self.clearance = ti.ndarray(ti.f64, shape=max(n, 1))
+        self.allowance_inv2 = ti.ndarray(ti.f64, shape=max(n, 1))
+        self.allowance_inv2.fill(1e30)
+        #: the cap on every allowance at the last rebuild [m] (:meth:`rebuild`)
+        self.cap = math.inf
         self.cell_of = ti.ndarray(ti.i32, shape=n)
         self.cell_count = ti.ndarray(ti.i32, shape=grid.n_cells)
         self.cell_start = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
@@ -105,9 +118,10 @@ class NeighborList:
         self.nbr = ti.ndarray(ti.i32, shape=(self.n, width))
         self.count = ti.ndarray(ti.i32, shape=self.n)
 
-    def rebuild(self, p: ParticleArrays, walls: WallArrays) -> None:
+    def rebuild(self, p: ParticleArrays, walls: WallArrays, cap: float = math.inf) -> None:
         """Rebin the spheres, rebuild the rows and the pair list (history carried over), list the walls in reach,
-        and take the positions as the new Verlet reference."""
+        give every sphere its displacement allowance (at most ``cap`` [m]), and take the positions as the new
+        Verlet reference."""
         grid = self.grid
         if grid.period > 0.0:
             neighbors.wrap_positions(p.x, p.x_r, grid.origin[0], grid.period)
@@ -118,8 +132,8 @@ class NeighborList:
 
         def build_rows() -> int:
             return neighbors.build_neighbor_lists(
-                p.x, p.r, self.cell_start, self.sorted_ids, origin, inv_cell, dims, self.skin,
-                grid.period, grid.inv_period, self.nbr, self.count,
+                p.x, p.r, self.cell_start, self.sorted_ids, origin, inv_cell, dims, self.skin, self.r_max,
+                grid.period, grid.inv_period, self.nbr, self.count, self.clearance,
             )
 
         most = build_rows()
@@ -152,7 +166,9 @@ class NeighborList:
         neighbors.fill_reverse_index(new.j, n_pairs, self.rev_start, self.cursor, new.rev_pair, new.rev)
         new.partner_slot.fill(0.0)
         self.pairs, self.spare, self.n_pairs = new, old, n_pairs
-        neighbors.near_walls(p.x, p.r, walls.point, walls.normal, self.skin, walls.near)
+        neighbors.near_walls(p.x, p.r, walls.point, walls.normal, self.skin, walls.near, self.clearance)
+        self.cap = float(cap)
+        neighbors.displacement_allowance(self.clearance, self.skin, min(self.cap, 1e300), self.allowance_inv2)
         integrator.copy_vec3(p.x, p.x_ref)
 
     def history(self) -> dict:

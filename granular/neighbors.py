@@ -99,12 +99,20 @@ def build_neighbor_lists(
     inv_cell: ti.f64,
     dims: ivec3,
     skin: ti.f64,
+    r_max: ti.f64,
     period: ti.f64,
     inv_period: ti.f64,
     nbr: nd_i32_2d,
     nbr_count: nd_i32,
+    clearance: nd_f64,
 ) -> ti.i32:
-    """Fill each particle's row with the partners j > i closer than r_i + r_j + skin, sorted by j.
+    """Fill each particle's row with the partners j > i closer than r_i + r_j + skin, sorted by j, and
+    ``clearance[i]`` [m] with a lower bound on the gap d_ij - r_i - r_j from i to every sphere listed with it by
+    neither row (j > i in i's row, j < i in j's row): the least such gap among the spheres of the 27 cells searched,
+    and for those beyond them the distance from x_i to the searched block's faces less r_i and ``r_max`` (the
+    largest radius). It is at least ``skin`` wherever i lies inside the grid; a sphere clamped into a boundary cell
+    from outside may get less (down to 0), which only makes its allowance the plain half skin
+    (:func:`displacement_allowance`).
 
     ``period`` > 0 makes the domain periodic along x with that length (``inv_period`` = 1 / period;
     both 0 otherwise): the cells wrap around in x (the grid must have at least 3 cells along x and a
@@ -118,6 +126,10 @@ def build_neighbor_lists(
         xi = x[i]
         ri = radius[i]
         c = cell_coords(xi, origin, inv_cell, dims)
+        # x_i's place in its cell [cells]; the searched block spans [-1, 2) of it on every axis
+        u = (xi - origin) * inv_cell - ti.cast(c, ti.f64)
+        to_faces = ti.min((u + 1.0).min(), (2.0 - u).min()) / inv_cell
+        clear = ti.max(to_faces - ri - r_max, 0.0)
         count = 0
         for dz, dy, dx in ti.ndrange((-1, 2), (-1, 2), (-1, 2)):
             cc = c + ivec3(dx, dy, dz)
@@ -127,33 +139,65 @@ def build_neighbor_lists(
                 cid = cell_index(cc, dims)
                 for s in range(cell_start[cid], cell_start[cid + 1]):
                     j = sorted_ids[s]
-                    if j > i:
-                        reach = ri + radius[j] + skin
-                        if nearest_image(x[j] - xi, period, inv_period).norm_sqr() < reach * reach:
-                            if count < width:
-                                nbr[i, count] = j
-                            count += 1
+                    if j != i:
+                        touch = ri + radius[j]
+                        reach = touch + skin
+                        d2 = nearest_image(x[j] - xi, period, inv_period).norm_sqr()
+                        if d2 < reach * reach:
+                            if j > i:
+                                if count < width:
+                                    nbr[i, count] = j
+                                count += 1
+                        elif d2 < (clear + touch) * (clear + touch):
+                            clear = ti.sqrt(d2) - touch
         kept = ti.min(count, width)
         sort_row(nbr, i, 0, kept)  # by partner index
         nbr_count[i] = kept
+        clearance[i] = clear
         ti.atomic_max(most, count)
     return most
 
 
 @ti.kernel
-def near_walls(x: nd_vec3, radius: nd_f64, wall_point: nd_vec3, wall_normal: nd_vec3, skin: ti.f64, wall_near: nd_i32):
+def near_walls(x: nd_vec3, radius: nd_f64, wall_point: nd_vec3, wall_normal: nd_vec3, skin: ti.f64, wall_near: nd_i32,
+               clearance: nd_f64):
     """wall_near[i] = bit mask of the planar walls w whose signed distance to particle i's centre,
-    (x_i - p_w) . n_w, is below r_i + skin: the only walls i can touch before the next rebuild,
-    since no particle moves more than skin / 2 in between (walls do not move). The force pass
-    checks just these instead of every wall for every particle."""
+    (x_i - p_w) . n_w, is below r_i + skin: the only walls i can touch before the next rebuild, since
+    no particle moves its gap to a wall it does not list in between (walls do not move;
+    :func:`displacement_allowance`). The gap to each wall not listed lowers ``clearance[i]`` [m] (from
+    :func:`build_neighbor_lists`). The force pass checks just these instead of every wall for every
+    particle."""
     for i in x:
         xi = x[i]
         reach = radius[i] + skin
         mask = 0
+        clear = clearance[i]
         for w in range(wall_point.shape[0]):
-            if (xi - wall_point[w]).dot(wall_normal[w]) < reach:
+            above = (xi - wall_point[w]).dot(wall_normal[w])
+            if above < reach:
                 mask |= 1 << w
+            else:
+                clear = ti.min(clear, above - radius[i])
         wall_near[i] = mask
+        clearance[i] = clear
+
+
+@ti.kernel
+def displacement_allowance(clearance: nd_f64, skin: ti.f64, cap: ti.f64, allowance_inv2: nd_f64):
+    """Each sphere's displacement allowance a_i until the next rebuild, stored as 1 / a_i^2 [1/m^2]:
+
+        a_i = min(max(skin, c_i) / 2, cap),   c_i = ``clearance[i]``.
+
+    The lists stay complete while every sphere keeps within its allowance: a pair (i, j) listed by neither had a
+    gap g_ij >= max(skin, c_i, c_j) at the rebuild, and a_i + a_j <= max(skin, c_i) / 2 + max(skin, c_j) / 2 <=
+    g_ij, so the pair cannot have closed it; a wall w not listed by i had a gap >= c_i >= 2 a_i. This is the
+    Verlet test (rebuild once any sphere has moved half the skin; Allen & Tildesley, *Computer Simulation of
+    Liquids*, sec. 5.3.1) with each sphere's own clearance in place of the skin: a grain thrown clear of the bed,
+    whose nearest sphere is far, no longer sets the whole bed's rebuild rate. ``cap`` [m] bounds every allowance for
+    what else relies on it (an interaction's candidate lists: :meth:`~.scene.Scene.displacement_cap`)."""
+    for i in clearance:
+        a = ti.min(0.5 * ti.max(skin, clearance[i]), cap)
+        allowance_inv2[i] = 1.0 / (a * a)
 
 
 @ti.func

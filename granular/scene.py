@@ -23,6 +23,8 @@ are mixed in; the class itself keeps the clock, the time step and the stepping s
 
 from __future__ import annotations
 
+import math
+
 from typing import Callable
 
 from . import runtime
@@ -114,6 +116,7 @@ class Scene(SceneEdits, SceneReadout):
         self._dt: float | None = None
         self._n_contacts = 0
         self.neighbor_rebuilds = 0
+        self._rebuild_requested = False
         #: Run the force pass and the integration as one launch per step when nothing else acts on
         #: the particles (granular.fused_step; the same arithmetic, fewer passes over memory).
         self.fuse_steps = True
@@ -196,7 +199,6 @@ class Scene(SceneEdits, SceneReadout):
         device = self._to_device()
         stepper = device.stepper
         gravity = tuple(float(c) for c in self.gravity)
-        half_skin2 = (0.5 * device.neighbor_list.skin) ** 2
         external = bool(self.interactions)
         # The force pass, the closing half kick and the next step's opening kick and drift run as one
         # launch (fused_step), except before a step whose state is read; interactions evaluate their
@@ -207,7 +209,7 @@ class Scene(SceneEdits, SceneReadout):
         for k in range(n):
             if not drifted:
                 largest = stepper.kick_drift(gravity, dt)
-            if largest > half_skin2:
+            if largest > 1.0 or self._rebuild_requested:  # a sphere past its allowance, or an interaction asks
                 self._rebuild_neighbors()
             n_external = 0
             for body in self.interactions:
@@ -264,8 +266,24 @@ class Scene(SceneEdits, SceneReadout):
 
     def _rebuild_neighbors(self) -> None:
         device = self._device
-        device.neighbor_list.rebuild(device.particles, device.walls)
+        device.neighbor_list.rebuild(device.particles, device.walls, self.displacement_cap())
         self.neighbor_rebuilds += 1
+        self._rebuild_requested = False
+
+    def request_neighbor_rebuild(self) -> None:
+        """Rebuild the neighbour lists at the start of the next step (after its drift, before the interactions
+        evaluate their contacts): an interaction asks this when its own candidate lists need rebuilding, so that
+        every candidate build shares the scene's Verlet reference (:meth:`displacement_cap`)."""
+        self._rebuild_requested = True
+
+    def displacement_cap(self) -> float:
+        """The most [m] any sphere may move between two neighbour rebuilds: the least ``displacement_cap(scene)``
+        of the interactions that bound it (an interaction whose candidate lists were built with a margin for the
+        spheres' motion since the last rebuild), infinite when none does. Each sphere's own allowance is its
+        clearance at the rebuild, halved (:func:`.neighbors.displacement_allowance`), within this cap."""
+        caps = [float(body.displacement_cap(self)) for body in self.interactions
+                if callable(getattr(body, "displacement_cap", None))]
+        return min(caps, default=math.inf)
 
     def _to_host(self) -> None:
         """Copy the device state back to NumPy and drop the device arrays (before structural edits)."""

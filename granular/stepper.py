@@ -25,7 +25,8 @@ class Stepper:
     def __init__(self, particles: ParticleArrays, neighbor_list: NeighborList, walls: WallArrays,
                  params: ContactParameters) -> None:
         self.particles, self.neighbor_list, self.walls, self.params = particles, neighbor_list, walls, params
-        #: [0] contacts of the last force pass, [1] the largest squared drift since the last rebuild.
+        #: [0] contacts of the last force pass, [1] the largest squared drift since the last rebuild over the
+        #: sphere's squared allowance (a rebuild is due above 1).
         self.result = ti.ndarray(ti.f64, shape=2)
         self._pairs = None
         self._contact_args: tuple = ()
@@ -44,20 +45,22 @@ class Stepper:
         return self._contact_args
 
     def kick_drift(self, gravity, dt: float) -> float:
-        """Opening half kick and drift; returns the largest squared displacement since the last rebuild [m^2]."""
+        """Opening half kick and drift; returns the largest squared displacement since the last rebuild over the
+        sphere's squared allowance (a rebuild is due above 1)."""
         p = self.particles
-        integrator.kick_drift_graph(p.x, p.v, p.w, p.f, p.t, p.m, p.I, p.mobile, *gravity, dt, p.x_ref, p.r, p.x_r,
-                                    p.v_m, p.w_i, self.result)
+        integrator.kick_drift_graph(p.x, p.v, p.w, p.f, p.t, p.m, p.I, p.mobile, *gravity, dt, p.x_ref,
+                                    self.neighbor_list.allowance_inv2, p.r, p.x_r, p.v_m, p.w_i, self.result)
         return float(self.result[0])
 
     def fused(self, gravity, dt: float, *, external: bool, drift: bool) -> tuple[int, float]:
         """Force pass and closing half kick, then (``drift``) the next step's opening kick and drift, in one launch;
-        returns the contacts and the largest squared displacement since the last rebuild [m^2]."""
+        returns the contacts and the largest squared displacement since the last rebuild over the sphere's squared
+        allowance (a rebuild is due above 1)."""
         p, grid = self.particles, self.neighbor_list.grid
         fused_step.contact_step_graph(
             p.x, p.v, p.w, p.r, p.m, p.I, p.mobile, *self._pair_args(), dt,
             grid.period, grid.inv_period, int(external), p.f_ext, p.t_ext, p.f, p.t,
-            *gravity, int(drift), p.x_ref, p.x_r, p.v_m, p.w_i, self.result,
+            *gravity, int(drift), p.x_ref, self.neighbor_list.allowance_inv2, p.x_r, p.v_m, p.w_i, self.result,
         )
         return int(self.result[0]), float(self.result[1])
 

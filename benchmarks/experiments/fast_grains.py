@@ -1,12 +1,14 @@
 """Which sphere sets the neighbour-rebuild rate of a coupled run: the CMU twin's protocol, then the fastest spheres.
 
-The soil's neighbour list is rebuilt whenever any sphere has moved half the skin since the last build, so one fast
-grain sets the whole bed's rebuild rate. This runs ``cmu-grouser`` (with ``--set`` overrides, e.g. finer particles)
+The soil's neighbour list was rebuilt whenever any sphere had moved half the skin since the last build, so one fast
+grain set the whole bed's rebuild rate (since 2026-11-29 each sphere has its own allowance, half its clearance within
+a cap: :func:`wheelsoil.granular.neighbors.displacement_allowance`, which thrown grains were the reason for).
+This runs ``cmu-grouser`` (with ``--set`` overrides, e.g. finer particles)
 through its protocol with a short drive, then steps on in chunks and prints, per chunk, the rebuilds so far and the
 fastest sphere (speed, position, radius) and how many move faster than 0.5 and 1 m/s::
 
     python benchmarks/experiments/fast_grains.py --set soil.diameter_min=0.003072 soil.diameter_max=0.004608 \\
-        --chunks 12 --steps 5
+        --chunks 12 --steps 5 [--watch-protocol]
 
 (2026-11-29, benchmarks/README.md: at about 100,000 spheres a grain rising at 4.0 m/s beside the wheel forced a
 rebuild every five steps; at the twin's 21,485, a grain falling inside the open drum at 0.3 m/s, one every 70.)
@@ -26,6 +28,9 @@ def main(argv=None) -> int:
     ap.add_argument("--drive-time", type=float, default=0.3, help="the protocol's drive [s] (default 0.3)")
     ap.add_argument("--chunks", type=int, default=20, help="chunks stepped after the protocol (default 20)")
     ap.add_argument("--steps", type=int, default=10, help="DEM steps a chunk (default 10)")
+    ap.add_argument("--watch-protocol", action="store_true",
+                    help="also print, after every sample of the protocol, its phase, the fastest sphere and the "
+                         "neighbour rebuilds in the sample (where a grain is thrown)")
     args = ap.parse_args(argv)
 
     from wheelsoil import runtime
@@ -40,9 +45,20 @@ def main(argv=None) -> int:
                                      "output.average_time=0.1", "output.render=false"])
     bed = prepare_bed(build.bed_spec(case))
     bench = Testbed(bed, build.wheel_geometry(case), build.testbed_spec(case))
-    t0 = time.perf_counter()
-    bench.run()
     scene = bench.scene
+    seen = {"rebuilds": 0}
+
+    def watch(tb) -> None:
+        speed = np.linalg.norm(scene.velocities, axis=1)
+        i = int(np.argmax(speed))
+        print(f"{tb.phase:8s} t = {scene.time:.4f} s: fastest {speed[i]:.3f} m/s at "
+              f"{np.round(1e3 * scene.positions[i], 1)} mm (radius {1e3 * scene.radii[i]:.2f} mm), rebuilds in the "
+              f"sample {scene.neighbor_rebuilds - seen['rebuilds']}, hub at {np.round(1e3 * tb.structure.hub_position, 1)}"
+              " mm", flush=True)
+        seen["rebuilds"] = scene.neighbor_rebuilds
+
+    t0 = time.perf_counter()
+    bench.run(on_sample=watch if args.watch_protocol else None)
     print(f"protocol {time.perf_counter() - t0:.0f} s; {scene.n_particles} spheres, skin "
           f"{1e3 * scene.device.neighbor_list.skin:.3f} mm, DEM step {scene.time_step:.3e} s", flush=True)
     start = scene.neighbor_rebuilds
