@@ -32,5 +32,5 @@ start "wide-box calibration, then its choice's checks (issue 33)" \
     --out docs/soillab/calibration-epsd-box --resume --cache "$1/lab-cache" \
     && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
   "$PY" "$RUNS"
-start "not-worse campaigns (issue 36)" "validation/campaigns/not-worse.sh|validation_campaign.py" "$RUNS/not-worse.out" \
-  bash docs/validation/campaigns/not-worse.sh
+start "five-gravity campaigns (issue 36)" "validation/campaigns/five-gravities.sh|validation_campaign.py" \
+  "$RUNS/five-gravities.out" bash docs/validation/campaigns/five-gravities.sh

@@ -4,7 +4,7 @@
   case that has a checkpoint under ``RUNS/*/cases`` its simulated time and when it was written;
 * the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective,
   then the checks on its choice (``docs/soillab/choice-checks/run.sh``): the steps finished and the last log line;
-* the validation campaigns that ``docs/validation/campaigns/not-worse.sh`` runs: the draws each has of its target.
+* the validation campaigns that ``docs/validation/campaigns/five-gravities.sh`` runs: the draws each has of its target.
 
 Reads files only (it starts and stops nothing), so it can run beside the jobs::
 
@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "not-worse.sh"
+CAMPAIGN_SCRIPT = ROOT / "docs" / "validation" / "campaigns" / "five-gravities.sh"
 CALIBRATION = ROOT / "docs" / "soillab" / "calibration-epsd-box" / "candidates"
 #: Candidates in the wide-box design (the nine grid points and the earlier surface minimum, docs/soillab/README.md).
 CALIBRATION_CANDIDATES = 10

@@ -9,6 +9,7 @@ Usage (from the repository root; 15-60 s a draw on one core, ``--workers`` proce
     python docs/validation_campaign.py ooc    --draws 30 --seed 4 --workers 2   # effects outside the catalogue
     python docs/validation_campaign.py ooc-load --draws 40 --seed 41 --workers 2 --resume  # load and gravity varied
     python docs/validation_campaign.py single --draws 44 --seed 82 --design whole-domain  # braking, dragged, 90 deg
+    python docs/validation_campaign.py single --draws 44 --seed 122 --design whole-domain-5g  # five gravity levels
     python docs/validation_campaign.py periodic --draws 40 --seed 7             # periodic mechanisms in series
     python docs/validation_campaign.py summary docs/validation/campaigns/*.jsonl  # the table of rates
 
@@ -43,8 +44,9 @@ KINDS = ("null", "single", "pair", "ooc", "ooc-load")
 #: The synthetic designs a campaign can draw its conditions from (``--design``): ``factorial``, the generators' rig
 #: (:func:`wheelsoil.validation.synthetic.conditions`: driving slips, 0-30 deg; ``ooc-load`` always uses its own
 #: load-and-gravity design); ``whole-domain``, the rig's whole domain (braking, dragged and 90 deg rows too:
-#: :func:`wheelsoil.validation.synthetic.whole_domain_conditions`, issue 36 item 6).
-DESIGNS = ("factorial", "whole-domain")
+#: :func:`wheelsoil.validation.synthetic.whole_domain_conditions`, issue 36 item 6); ``whole-domain-5g``, the same at
+#: five gravity levels instead of three (:func:`~wheelsoil.validation.synthetic.whole_domain_five_gravity_conditions`).
+DESIGNS = ("factorial", "whole-domain", "whole-domain-5g")
 
 
 def design_conditions(kind: str, design: str):
@@ -53,6 +55,8 @@ def design_conditions(kind: str, design: str):
 
     if kind == "ooc-load":
         return syn.load_gravity_conditions()
+    if design == "whole-domain-5g":
+        return syn.whole_domain_five_gravity_conditions()
     return syn.whole_domain_conditions() if design == "whole-domain" else None
 
 
@@ -186,8 +190,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=None)
     ap.add_argument("--resume", action="store_true", help="keep the draws the output file holds; run the rest")
     ap.add_argument("--design", choices=DESIGNS, default="factorial",
-                    help="the synthetic conditions: the generators' factorial (default) or the rig's whole domain "
-                         "(braking, dragged and 90 deg rows too)")
+                    help="the synthetic conditions: the generators' factorial (default), the rig's whole domain "
+                         "(braking, dragged and 90 deg rows too), or the whole domain at five gravity levels")
     ap.add_argument("--noise", type=float, default=0.03,
                     help="periodic: red-noise standard deviation / median steady drawbar pull (default 0.03)")
     args = ap.parse_args(argv)

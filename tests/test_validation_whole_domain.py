@@ -218,3 +218,23 @@ def test_the_whole_domain_synthetic_design_holds_braking_dragged_and_sideways_ro
             assert set(data.load[rows]) == {60.0, 120.0} and len(set(data.gravity[rows])) == 3
     np.testing.assert_array_equal(data.travel_slip, cond["travel_slip"])
     assert all(np.isfinite(y).all() for y in data.responses.values())
+
+
+def test_the_five_gravity_design_is_the_whole_domain_at_five_levels_with_the_passes_balanced():
+    """The design fixed for the gravity ties (docs/validation/campaigns.md): the whole domain at 1.62-9.81 m/s^2 in five
+    levels (seed 000's three among them), every row of the three-level design at each, and the pass number not
+    aliased with the gravity (each level sees every pass about equally)."""
+    from wheelsoil.validation.synthetic import FIVE_GRAVITY_LEVELS, whole_domain_conditions, \
+        whole_domain_five_gravity_conditions
+    five, three = whole_domain_five_gravity_conditions(), whole_domain_conditions()
+    levels = np.unique(five["gravity"])
+    assert len(levels) == 5 and {1.62, 3.71} <= set(levels.tolist()) and np.isclose(levels.max(), 9.81, atol=0.01)
+    assert np.all(np.diff(np.log(levels)) < 1.6 * np.log(levels[-1] / levels[0]) / 4)  # none far from even in log g
+    assert len(five["slip"]) == len(three["slip"]) // 3 * 5
+    for g in FIVE_GRAVITY_LEVELS:
+        at = five["gravity"] == g
+        rows = sorted(zip(five["travel_slip"][at], five["slip_angle"][at], five["load"][at]))
+        assert rows == sorted(zip(three["travel_slip"][three["gravity"] == 1.62],
+                                  three["slip_angle"][three["gravity"] == 1.62], three["load"][three["gravity"] == 1.62]))
+        counts = np.bincount(five["passes"][at].astype(int), minlength=4)[1:]
+        assert counts.max() - counts.min() <= 2

@@ -122,6 +122,19 @@ WHOLE_DOMAIN_SLIPS = (-1.0, -0.5, -0.2, 0.05, 0.2, 0.35, 0.5, 0.7)
 SIDEWAYS_SLIPS = (-1.0, 0.2, 0.5)
 
 
+#: Five gravity levels [m/s^2], about evenly spaced in log g from the Moon to the Earth with Mars among them: the three
+#: of seed 000's flights plus 2.45 (a quarter g) and 6.0. With three levels a power law in g (a gravity mechanism)
+#: and another parameter's linear drift along g differ only in how they bend between the levels, and at the
+#: campaigns' noise they often fit alike (docs/validation/campaigns.md, "the gravity ties"); five levels show the bend.
+FIVE_GRAVITY_LEVELS = (EARTH_GRAVITY, 6.0, 3.71, 2.45, 1.62)
+
+
+def whole_domain_five_gravity_conditions():
+    """:func:`whole_domain_conditions` at the :data:`FIVE_GRAVITY_LEVELS` (350 conditions): the design fixed on
+    2026-11-29, before any of its draws, to ask whether the gravity ties are the design's or the rules'."""
+    return whole_domain_conditions(gravities=FIVE_GRAVITY_LEVELS)
+
+
 def whole_domain_conditions(slips=WHOLE_DOMAIN_SLIPS, slip_angles=(0.0, 10.0, 20.0, 30.0),
                             sideways_slips=SIDEWAYS_SLIPS, loads=(60.0, 120.0),
                             gravities=(EARTH_GRAVITY, 3.71, 1.62), passes=(1, 2, 3)):
