@@ -65,12 +65,13 @@ COUPLED_PARTS = {"smoke": "smoke-1g-steer", "cmu": "cmu-grouser"}
 
 
 def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"], rounds: int = 6,
-               overrides: tuple[str, ...] = (), half_skin_too: bool = False) -> dict:
+               overrides: tuple[str, ...] = (), half_skin_too: bool = False, sphere_skins: tuple = ()) -> dict:
     """The whole protocol of ``preset`` with a short drive, then ``steps`` timed DEM steps of steady driving by part,
     alternating in ``rounds`` chunks with as many steps of the same bed alone (module docstring, part 1; ``preset``
     cmu-grouser: the CMU twin's rigid wheel on its calibrated sand, issue 37 item 2). ``overrides``: the case's
     ``KEY=VALUE`` settings (as ``wheelsoil run --set``), e.g. finer particles for the rig at its own scale;
-    ``half_skin_too``: time the half-skin rebuild rule too, in the same rounds (:func:`_coupled_against_soil`)."""
+    ``half_skin_too``, ``sphere_skins``: time the half-skin rebuild rule and other margins for the spheres' motion too,
+    in the same rounds (:func:`_coupled_against_soil`)."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed
@@ -103,7 +104,7 @@ def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS[
         "fe_time_step_s": info["fe_time_step"],
         "fe_substeps_per_dem_step": info["fe_substeps"] / info["dem_steps"],
     }
-    out.update(_coupled_against_soil(bench, bed, case, steps, rounds, arch, half_skin_too))
+    out.update(_coupled_against_soil(bench, bed, case, steps, rounds, arch, half_skin_too, sphere_skins))
     return out
 
 
@@ -142,11 +143,14 @@ class _Tally:
         return seconds
 
 
-def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_skin_too: bool = False) -> dict:
+def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_skin_too: bool = False,
+                          sphere_skins: tuple[float, ...] = ()) -> dict:
     """``steps`` DEM steps of the running testbed ``bench``, timed by part, alternating in ``rounds`` chunks with as
-    many steps of its bed ``bed`` alone (:func:`smoke_part`). ``half_skin_too``: each round also steps the testbed as
-    many steps under the half-skin rule (:class:`~wheelsoil.granular.interaction.HalfSkinRule`), timed apart
-    (``half_skin_*`` figures)."""
+    many steps of its bed ``bed`` alone (:func:`smoke_part`). Each round can also step the testbed as many steps in
+    other settings, timed apart: ``half_skin_too``, under the half-skin rule
+    (:class:`~wheelsoil.granular.interaction.HalfSkinRule`; ``half_skin_*`` figures); ``sphere_skins``, with the wheel
+    contact's margin for the spheres' motion (its cap on their allowance) at each of these many skins
+    (``sphere_skins`` figures)."""
     from wheelsoil.cases import build
     from wheelsoil.coupling.rig import soil_headroom
     from wheelsoil.granular.interaction import HalfSkinRule
@@ -165,13 +169,21 @@ def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_
     _timed(c, "add_forces", totals, "contact")
     _timed(c, "_rebuild", totals, "rebuild")
     blocks = max(1, steps // (10 * rounds))  # blocks of 10 steps per round
-    today, half, rule = _Tally(), _Tally(), HalfSkinRule()
+    default_skins, rule = c.sphere_skins, HalfSkinRule()
+    # the other settings: (name, set up, undo); each round steps every one of them, then today's, then the soil alone
+    others = [("half skin", lambda: scene.interactions.append(rule), lambda: scene.interactions.remove(rule))] \
+        if half_skin_too else []
+    for k in sphere_skins:
+        others.append((f"sphere skins {k:g}", lambda k=k: setattr(c, "sphere_skins", float(k)),
+                       lambda: setattr(c, "sphere_skins", default_skins)))
+    today, tallies = _Tally(), {name: _Tally() for name, _, _ in others}
     soil_total = soil_cpu = 0.0
     for _ in range(rounds):
-        if half_skin_too:
-            scene.interactions.append(rule)
-            half_round = half.step(bench, blocks, totals)
-            scene.interactions.remove(rule)
+        other_rounds = {}
+        for name, enter, leave in others:
+            enter()
+            other_rounds[name] = tallies[name].step(bench, blocks, totals)
+            leave()
         seconds = today.step(bench, blocks, totals)
         t0, cpu0 = time.perf_counter(), time.process_time()
         soil.step(10 * blocks)
@@ -179,17 +191,21 @@ def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_
         soil_total += soil_round
         soil_cpu += time.process_time() - cpu0
         today.per_round.append(seconds / soil_round)
-        if half_skin_too:
-            half.per_round.append(half_round / soil_round)
+        for name, other in other_rounds.items():
+            tallies[name].per_round.append(other / soil_round)
     out = _figures(today, 10 * blocks * rounds, rounds, soil_total, soil_cpu)
-    if half_skin_too:
-        out.update({
-            "half_skin_ms_per_step": 1e3 * half.seconds / out["timed_steps"],
-            "half_skin_dem_neighbor_rebuilds": half.dem_rebuilds,
-            "half_skin_coupled_over_soil_alone": half.seconds / soil_total,
-            "half_skin_coupled_over_soil_alone_per_round": half.per_round,
-            "half_skin_over_allowance": half.seconds / today.seconds,
-        })
+    out["sphere_skins"] = default_skins
+    n = out["timed_steps"]
+    for name, t in tallies.items():
+        fig = {"ms_per_step": 1e3 * t.seconds / n, "dem_neighbor_rebuilds": t.dem_rebuilds,
+               "ms_per_step_contact_evaluation": 1e3 * (t.parts["contact"] - t.parts["rebuild"]) / n,
+               "coupled_over_soil_alone": t.seconds / soil_total, "coupled_over_soil_alone_per_round": t.per_round,
+               "over_today": t.seconds / today.seconds}
+        if name == "half skin":
+            out.update({f"half_skin_{key}": value for key, value in fig.items()})
+            out["half_skin_over_allowance"] = fig["over_today"]
+        else:
+            out.setdefault("variants", {})[name] = fig
     return out
 
 
@@ -370,7 +386,7 @@ def cmu_scale(args) -> int:
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
     cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"], args.rounds,
-                                     tuple(args.set), args.half_skin_too)
+                                     tuple(args.set), args.half_skin_too, tuple(args.sphere_skins))
     print(f"CMU scale ({cmu['case']}): {cmu['particles']} particles, rigid wheel of {cmu['fe_elements']} elements; "
           f"{cmu['wall_seconds_per_simulated_second']:.0f} s wall per simulated s over the protocol; per DEM step "
           f"{cmu['ms_per_step']:.2f} ms = soil {cmu['ms_per_step_soil']:.2f} + wheel {cmu['ms_per_step_wheel']:.2f} + "
@@ -387,6 +403,11 @@ def cmu_scale(args) -> int:
               f"{cmu['half_skin_dem_neighbor_rebuilds']} neighbour rebuilds, coupled / soil alone "
               f"{cmu['half_skin_coupled_over_soil_alone']:.2f}; half skin / allowance "
               f"{cmu['half_skin_over_allowance']:.2f}", flush=True)
+    for name, fig in cmu.get("variants", {}).items():
+        print(f"{name} (today {cmu['sphere_skins']:g}) in the same rounds: {fig['ms_per_step']:.2f} ms per step "
+              f"(contact {fig['ms_per_step_contact_evaluation']:.2f}), {fig['dem_neighbor_rebuilds']} neighbour "
+              f"rebuilds, coupled / soil alone {fig['coupled_over_soil_alone']:.2f}; over today's "
+              f"{fig['over_today']:.2f}", flush=True)
     return _write_report(args.out, report)
 
 
@@ -410,12 +431,17 @@ def main(argv=None) -> int:
     ap.add_argument("--half-skin-too", action="store_true",
                     help="with --cmu: each round also steps the testbed under the half-skin rebuild rule (every "
                          "sphere's allowance half the skin, as before the per-sphere allowance), timed apart")
+    ap.add_argument("--sphere-skins", nargs="+", type=float, default=[], metavar="K",
+                    help="with --cmu: each round also steps the testbed with the wheel contact's margin for the "
+                         "spheres' motion (its cap on their allowance) at K scene skins, timed apart")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.set and not args.cmu:
         ap.error("--set applies to the CMU part only (--cmu)")
-    if args.half_skin_too and not args.cmu:
-        ap.error("--half-skin-too applies to the CMU part only (--cmu)")
+    if (args.half_skin_too or args.sphere_skins) and not args.cmu:
+        ap.error("--half-skin-too and --sphere-skins apply to the CMU part only (--cmu)")
+    if any(not (math.isfinite(k) and k > 0) for k in args.sphere_skins):
+        ap.error(f"--sphere-skins {args.sphere_skins}: each must be a number of skins > 0")
     if args.rounds < 1 or args.steps < 10 * args.rounds:
         ap.error(f"--rounds {args.rounds} and --steps {args.steps}: give at least one round and 10 steps per round")
     if args.part:

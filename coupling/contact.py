@@ -123,7 +123,8 @@ class WheelContact(Interaction):
     health_every: steps between the structure's health checks.
     wheel_skin: how far [m] the wheel's surface may move before the candidate lists are rebuilt
         (default: four times the scene's skin); candidates are kept within the sphere's reach plus
-        :data:`SPHERE_SKINS` of the scene's skin (the spheres' motion) plus this (module docstring, *candidates*).
+        ``sphere_skins`` (default :data:`SPHERE_SKINS`) of the scene's skin, the spheres' motion, plus this (module
+        docstring, *candidates*; a change of the attribute takes effect at the scene's next rebuild).
     """
 
     def __init__(
@@ -135,10 +136,13 @@ class WheelContact(Interaction):
         advance_structure: bool = True,
         health_every: int = 200,
         wheel_skin: float | None = None,
+        sphere_skins: float = SPHERE_SKINS,
     ) -> None:
-        if wheel_skin is not None and not (math.isfinite(wheel_skin) and wheel_skin > 0):
-            raise WheelsoilInputError(f"wheel_skin = {wheel_skin!r} m must be a finite number > 0")
+        for key, value in (("wheel_skin", wheel_skin), ("sphere_skins", sphere_skins)):
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise WheelsoilInputError(f"{key} = {value!r} must be a finite number > 0")
         self._wheel_skin_request = wheel_skin
+        self.sphere_skins = float(sphere_skins)
         if not isinstance(structure, Structure):
             raise WheelsoilInputError(f"structure must be a flexwheel Structure, got {type(structure).__name__}")
         if not isinstance(pair, PairProperties):
@@ -146,8 +150,7 @@ class WheelContact(Interaction):
         self.structure = structure
         self.surface = ContactSurface.from_mesh(structure.mesh)
         wheel = structure.mesh.material
-        self.soil = soil
-        self.pair = pair
+        self.soil, self.pair = soil, pair
         self.e_eff = effective_modulus(soil, wheel)
         self.g_eff = effective_shear_modulus(soil, wheel)
         self.contact_moduli = (self.e_eff,)
@@ -179,7 +182,6 @@ class WheelContact(Interaction):
         n = scene.n_particles
         radii = scene.radii
         self.wheel_skin = self._wheel_skin_request or 4.0 * scene.skin
-        self.skin = self.displacement_cap(scene) + self.wheel_skin  # candidate margin
         self.r_max = float(radii.max())
         a = self._arrays
         a.clear()
@@ -204,6 +206,7 @@ class WheelContact(Interaction):
         # the soil's own grid (:meth:`Scene.grid`): a facet is binned into every cell its box grown by r_max + skin
         # meets, and a sphere reads only its cell, so any cell edge works
         grid = scene.grid
+        self.skin = self.displacement_cap(scene) + self.wheel_skin  # candidate margin
         if "cell_count" not in a or a["cell_count"].shape[0] != grid.n_cells:
             a["cell_count"] = ti.ndarray(ti.i32, shape=grid.n_cells)
             a["cell_start"] = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
@@ -260,8 +263,8 @@ class WheelContact(Interaction):
         return self._n_contacts
 
     def displacement_cap(self, scene: Scene) -> float:
-        """The most [m] a sphere may move between the scene's rebuilds: :data:`SPHERE_SKINS` of its skin."""
-        return SPHERE_SKINS * scene.skin
+        """The most [m] a sphere may move between the scene's rebuilds: ``sphere_skins`` of its skin."""
+        return self.sphere_skins * scene.skin
 
     def _launch_contacts(self, dt: float) -> None:
         """One evaluation of every contact (:func:`.kernels.wheel_contacts`, as a compute graph); its array
