@@ -28,6 +28,9 @@ def main(argv=None) -> int:
     ap.add_argument("--drive-time", type=float, default=0.3, help="the protocol's drive [s] (default 0.3)")
     ap.add_argument("--chunks", type=int, default=20, help="chunks stepped after the protocol (default 20)")
     ap.add_argument("--steps", type=int, default=10, help="DEM steps a chunk (default 10)")
+    ap.add_argument("--who-rebuilds", type=int, default=0, metavar="STEPS",
+                    help="after the chunks, step STEPS single steps and print, for each neighbour rebuild, the sphere "
+                         "that asked for it (displacement over allowance, speed, clearance, place)")
     ap.add_argument("--watch-protocol", action="store_true",
                     help="also print, after every sample of the protocol, its phase, the fastest sphere and the "
                          "neighbour rebuilds in the sample (where a grain is thrown)")
@@ -69,7 +72,37 @@ def main(argv=None) -> int:
         print(f"chunk {k}: rebuilds {scene.neighbor_rebuilds - start}, fastest {speed[i]:.3f} m/s at "
               f"{np.round(1e3 * scene.positions[i], 1)} mm (radius {1e3 * scene.radii[i]:.2f} mm), "
               f"{int((speed > 0.5).sum())} above 0.5 m/s, {int((speed > 1.0).sum())} above 1 m/s", flush=True)
+    if args.who_rebuilds:
+        who_rebuilds(scene, bench, args.who_rebuilds)
     return 0
+
+
+def who_rebuilds(scene, bench, steps: int) -> None:
+    """Single steps; before each, the sphere furthest past its allowance after the step's drift (|x + v dt - x_ref|^2
+    / a^2, read back from the device), printed whenever the step rebuilds the lists (below 1: the wheel asked)."""
+    nl, p = scene.device.neighbor_list, scene.device.particles
+    asked: dict[str, int] = {}
+    for _ in range(steps):
+        drifted = p.x.to_numpy() + scene.time_step * p.v.to_numpy()
+        ratio = ((drifted - p.x_ref.to_numpy()) ** 2).sum(axis=1) * nl.allowance_inv2.to_numpy()
+        clearance = nl.clearance.to_numpy()
+        before = scene.neighbor_rebuilds
+        scene.step(1)
+        if scene.neighbor_rebuilds == before:
+            continue
+        i = int(np.argmax(ratio))
+        if ratio[i] <= 1.0:
+            asked["the wheel"] = asked.get("the wheel", 0) + 1
+            continue
+        speed = float(np.linalg.norm(scene.velocities[i]))
+        hub = np.asarray(bench.structure.hub_position)
+        where = "far" if np.linalg.norm(scene.positions[i] - hub) > 1.5 * bench.wheel.radius else "near the wheel"
+        kind = "capped" if 1.0 / np.sqrt(nl.allowance_inv2.to_numpy()[i]) < 0.5 * clearance[i] * (1 - 1e-9) else "own"
+        asked[f"{where}, {kind}"] = asked.get(f"{where}, {kind}", 0) + 1
+        print(f"step {scene.steps_taken}: sphere {i} asked ({ratio[i]:.2f} of its allowance before the step), "
+              f"{speed:.3f} m/s, clearance {1e3 * clearance[i]:.3f} mm (skin {1e3 * nl.skin:.3f}), at "
+              f"{np.round(1e3 * scene.positions[i], 1)} mm, {where}", flush=True)
+    print(f"who asked, over {steps} steps: {asked}", flush=True)
 
 
 if __name__ == "__main__":
