@@ -238,3 +238,15 @@ def test_the_five_gravity_design_is_the_whole_domain_at_five_levels_with_the_pas
                                   three["slip_angle"][three["gravity"] == 1.62], three["load"][three["gravity"] == 1.62]))
         counts = np.bincount(five["passes"][at].astype(int), minlength=4)[1:]
         assert counts.max() - counts.min() <= 2
+
+
+def test_out_of_catalogue_effects_keep_a_valid_soil_on_the_whole_domain_at_their_strongest():
+    """Every out-of-catalogue effect at the top of its strength range gives data on the whole domain (five gravity
+    levels, the 90 deg rows at slip +-1) without leaving the soil's valid range: `ooc-124` stopped at its draw 26 on a
+    friction angle the slip-and-steering law took below zero there."""
+    from wheelsoil.validation.synthetic import OUT_OF_CATALOGUE, synthetic_measurements, \
+        whole_domain_five_gravity_conditions
+    cond = whole_domain_five_gravity_conditions()
+    for name, spec in OUT_OF_CATALOGUE.items():
+        data = synthetic_measurements({}, np.random.default_rng(1), cond=cond, effect=(name, spec["range"][1]))
+        assert all(np.all(np.isfinite(v)) for v in data.responses.values()), name

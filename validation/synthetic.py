@@ -45,7 +45,9 @@ HIDDEN_RANGES = {
 
 #: Effects the catalogue does not hold (the workflow must not give them a catalogue name): each a soil parameter
 #: that varies with a test condition in a way no extension models, with the range its strength is drawn from.
-#: ``field``: the SoilParameters field it changes; ``law(value, strength, cond)``: the field's value per row.
+#: ``field``: the SoilParameters field it changes; ``law(value, strength, cond)``: the field's value per row, held at
+#: ``floor`` or above where the effect gives one (a law written for the generators' factorial, driving slips and at
+#: most 30 deg, can leave the physical range on the whole domain's 90 deg rows).
 #: The first five are linear (or, over two loads, equivalent) drifts of one parameter with one condition, the form
 #: of the workflow's generic rivals (:func:`~.extensions.drift_rival`; the load drifts have no rival, since no
 #: mechanism acts through the load); the last two are outside that family too: a friction angle that rises and
@@ -81,8 +83,9 @@ OUT_OF_CATALOGUE = {
         "law": lambda v, d, c: v + d * np.sin(np.pi * np.minimum(np.abs(c["slip"]) / 0.7, 1.0))},
     "friction_slip_steering": {
         "description": "friction angle lost where the wheel both slips and slides sideways, phi - d (|i| / 0.7) "
-                       "(sin|beta| / sin 30 deg) (an interaction of two conditions)",
-        "field": "friction_angle", "range": (6.0, 12.0),
+                       "(sin|beta| / sin 30 deg) (an interaction of two conditions), at least 0.5 deg (at 90 deg and "
+                       "|i| = 1 the law alone takes up to 34 deg off the soil's 33)",
+        "field": "friction_angle", "range": (6.0, 12.0), "floor": 0.5,
         "law": lambda v, d, c: v - d * (np.abs(c["slip"]) / 0.7) * (
             np.sin(np.radians(np.abs(c["slip_angle"]))) / np.sin(np.radians(30.0)))},
     # effects that follow the load, which acts through the weight on the wheel as gravity does (issue 36: with
@@ -192,7 +195,7 @@ def _predict_with_effect(truth: SoilParameters, wheel: RigidWheel, cond: dict, e
     n = np.asarray(cond["slip"]).size
     arrays = {k: np.broadcast_to(np.asarray(v, float), (n,)) for k, v in cond.items()}
     values = spec["law"](getattr(truth, spec["field"]), strength, arrays)
-    values = np.broadcast_to(np.asarray(values, float), (n,))
+    values = np.maximum(np.broadcast_to(np.asarray(values, float), (n,)), spec.get("floor", -np.inf))
     out = {}
     for v in np.unique(values):
         rows = values == v
