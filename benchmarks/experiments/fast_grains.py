@@ -24,7 +24,8 @@ import numpy as np
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="the case's settings (wheelsoil run --set)")
+    ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
+                    help="the case's settings (wheelsoil run --set)")
     ap.add_argument("--drive-time", type=float, default=0.3, help="the protocol's drive [s] (default 0.3)")
     ap.add_argument("--chunks", type=int, default=20, help="chunks stepped after the protocol (default 20)")
     ap.add_argument("--steps", type=int, default=10, help="DEM steps a chunk (default 10)")
@@ -52,12 +53,9 @@ def main(argv=None) -> int:
     seen = {"rebuilds": 0}
 
     def watch(tb) -> None:
-        speed = np.linalg.norm(scene.velocities, axis=1)
-        i = int(np.argmax(speed))
-        print(f"{tb.phase:8s} t = {scene.time:.4f} s: fastest {speed[i]:.3f} m/s at "
-              f"{np.round(1e3 * scene.positions[i], 1)} mm (radius {1e3 * scene.radii[i]:.2f} mm), rebuilds in the "
-              f"sample {scene.neighbor_rebuilds - seen['rebuilds']}, hub at {np.round(1e3 * tb.structure.hub_position, 1)}"
-              " mm", flush=True)
+        print(f"{tb.phase:8s} t = {scene.time:.4f} s: {fastest(scene)[0]}, rebuilds in the sample "
+              f"{scene.neighbor_rebuilds - seen['rebuilds']}, hub at {np.round(1e3 * tb.structure.hub_position, 1)} mm",
+              flush=True)
         seen["rebuilds"] = scene.neighbor_rebuilds
 
     t0 = time.perf_counter()
@@ -67,14 +65,20 @@ def main(argv=None) -> int:
     start = scene.neighbor_rebuilds
     for k in range(args.chunks):
         scene.step(args.steps)
-        speed = np.linalg.norm(scene.velocities, axis=1)
-        i = int(np.argmax(speed))
-        print(f"chunk {k}: rebuilds {scene.neighbor_rebuilds - start}, fastest {speed[i]:.3f} m/s at "
-              f"{np.round(1e3 * scene.positions[i], 1)} mm (radius {1e3 * scene.radii[i]:.2f} mm), "
-              f"{int((speed > 0.5).sum())} above 0.5 m/s, {int((speed > 1.0).sum())} above 1 m/s", flush=True)
+        text, speed = fastest(scene)
+        print(f"chunk {k}: rebuilds {scene.neighbor_rebuilds - start}, {text}, {int((speed > 0.5).sum())} above "
+              f"0.5 m/s, {int((speed > 1.0).sum())} above 1 m/s", flush=True)
     if args.who_rebuilds:
         who_rebuilds(scene, bench, args.who_rebuilds)
     return 0
+
+
+def fastest(scene) -> tuple[str, np.ndarray]:
+    """The fastest sphere, described (speed, place, radius), and every sphere's speed [m/s]."""
+    speed = np.linalg.norm(scene.velocities, axis=1)
+    i = int(np.argmax(speed))
+    return (f"fastest {speed[i]:.3f} m/s at {np.round(1e3 * scene.positions[i], 1)} mm (radius "
+            f"{1e3 * scene.radii[i]:.2f} mm)"), speed
 
 
 def who_rebuilds(scene, bench, steps: int) -> None:
@@ -83,9 +87,11 @@ def who_rebuilds(scene, bench, steps: int) -> None:
     nl, p = scene.device.neighbor_list, scene.device.particles
     asked: dict[str, int] = {}
     for _ in range(steps):
-        drifted = p.x.to_numpy() + scene.time_step * p.v.to_numpy()
-        ratio = ((drifted - p.x_ref.to_numpy()) ** 2).sum(axis=1) * nl.allowance_inv2.to_numpy()
+        # the allowances and clearances of the lists in use (the step's rebuild replaces them)
+        allowance = 1.0 / np.sqrt(nl.allowance_inv2.to_numpy())
         clearance = nl.clearance.to_numpy()
+        drifted = p.x.to_numpy() + scene.time_step * p.v.to_numpy()
+        ratio = ((drifted - p.x_ref.to_numpy()) ** 2).sum(axis=1) / allowance**2
         before = scene.neighbor_rebuilds
         scene.step(1)
         if scene.neighbor_rebuilds == before:
@@ -97,7 +103,7 @@ def who_rebuilds(scene, bench, steps: int) -> None:
         speed = float(np.linalg.norm(scene.velocities[i]))
         hub = np.asarray(bench.structure.hub_position)
         where = "far" if np.linalg.norm(scene.positions[i] - hub) > 1.5 * bench.wheel.radius else "near the wheel"
-        kind = "capped" if 1.0 / np.sqrt(nl.allowance_inv2.to_numpy()[i]) < 0.5 * clearance[i] * (1 - 1e-9) else "own"
+        kind = "capped" if allowance[i] < 0.5 * clearance[i] * (1 - 1e-9) else "own"
         asked[f"{where}, {kind}"] = asked.get(f"{where}, {kind}", 0) + 1
         print(f"step {scene.steps_taken}: sphere {i} asked ({ratio[i]:.2f} of its allowance before the step), "
               f"{speed:.3f} m/s, clearance {1e3 * clearance[i]:.3f} mm (skin {1e3 * nl.skin:.3f}), at "
