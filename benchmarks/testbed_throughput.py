@@ -33,31 +33,14 @@ import statistics
 import subprocess
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from wheelsoil import runtime
 from wheelsoil.benchmarks.common import machine, own_peak_rss_mib, versions
+from wheelsoil.benchmarks.coupled_rounds import coupled_against_soil
 
 SEED004_PARTICLES = 388_026
 SEED004_DRIVE_TIME = 2.5
-
-
-def _timed(obj, name: str, totals: dict, key: str) -> None:
-    """Replace ``obj.name`` by a wrapper that adds its wall time to ``totals[key]`` and the CPU time of all the
-    process's threads to ``totals[key + "_cpu"]``."""
-    inner = getattr(obj, name)
-    totals.setdefault(key + "_cpu", 0.0)
-
-    def wrapper(*args, **kwargs):
-        t0, cpu0 = time.perf_counter(), time.process_time()
-        try:
-            return inner(*args, **kwargs)
-        finally:
-            totals[key] += time.perf_counter() - t0
-            totals[key + "_cpu"] += time.process_time() - cpu0
-
-    setattr(obj, name, wrapper)
 
 
 #: The coupled parts: name -> the case preset they run.
@@ -65,13 +48,15 @@ COUPLED_PARTS = {"smoke": "smoke-1g-steer", "cmu": "cmu-grouser"}
 
 
 def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS["smoke"], rounds: int = 6,
-               overrides: tuple[str, ...] = (), half_skin_too: bool = False, sphere_skins: tuple = ()) -> dict:
+               overrides: tuple[str, ...] = (), half_skin_too: bool = False, sphere_skins: tuple = (),
+               narrow_too: bool = False) -> dict:
     """The whole protocol of ``preset`` with a short drive, then ``steps`` timed DEM steps of steady driving by part,
     alternating in ``rounds`` chunks with as many steps of the same bed alone (module docstring, part 1; ``preset``
     cmu-grouser: the CMU twin's rigid wheel on its calibrated sand, issue 37 item 2). ``overrides``: the case's
     ``KEY=VALUE`` settings (as ``wheelsoil run --set``), e.g. finer particles for the rig at its own scale;
-    ``half_skin_too``, ``sphere_skins``: time the half-skin rebuild rule and other margins for the spheres' motion too,
-    in the same rounds (:func:`_coupled_against_soil`)."""
+    ``half_skin_too``, ``sphere_skins``, ``narrow_too``: time the half-skin rebuild rule, other margins for the spheres'
+    motion and the allowance before the widened search too,
+    in the same rounds (:func:`.coupled_rounds.coupled_against_soil`)."""
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.coupling.testbed import Testbed
@@ -104,148 +89,8 @@ def smoke_part(steps: int, drive_time: float, arch, preset: str = COUPLED_PARTS[
         "fe_time_step_s": info["fe_time_step"],
         "fe_substeps_per_dem_step": info["fe_substeps"] / info["dem_steps"],
     }
-    out.update(_coupled_against_soil(bench, bed, case, steps, rounds, arch, half_skin_too, sphere_skins))
+    out.update(coupled_against_soil(bench, bed, case, steps, rounds, arch, half_skin_too, sphere_skins, narrow_too))
     return out
-
-
-#: The coupled step's timed parts (wrapped methods of the wheel contact), each with its CPU time beside.
-_PARTS = ("wheel", "contact", "rebuild", "wheel_cpu", "contact_cpu", "rebuild_cpu")
-
-
-@dataclass
-class _Tally:
-    """What the coupled steps under one rebuild rule took, summed over the rounds."""
-
-    seconds: float = 0.0
-    cpu: float = 0.0
-    wheel_rebuilds: int = 0
-    dem_rebuilds: int = 0
-    contacts: int = 0
-    parts: dict = field(default_factory=lambda: dict.fromkeys(_PARTS, 0.0))
-    per_round: list = field(default_factory=list)
-
-    def step(self, bench, blocks: int, totals: dict) -> float:
-        """``blocks`` of 10 coupled steps from a fresh neighbour rebuild, added to the tally; their wall time [s]."""
-        c, scene = bench.contact, bench.scene
-        scene.request_neighbor_rebuild()  # each round starts from a rebuild under its own rule
-        r0, d0, before = c.rebuilds, scene.neighbor_rebuilds, dict(totals)
-        t0, cpu0 = time.perf_counter(), time.process_time()
-        for _ in range(blocks):
-            scene.step(10)
-            self.contacts += c.contact_count
-        seconds = time.perf_counter() - t0
-        self.seconds += seconds
-        self.cpu += time.process_time() - cpu0
-        self.wheel_rebuilds += c.rebuilds - r0
-        self.dem_rebuilds += scene.neighbor_rebuilds - d0
-        for key in _PARTS:
-            self.parts[key] += totals[key] - before[key]
-        return seconds
-
-
-def _coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_skin_too: bool = False,
-                          sphere_skins: tuple[float, ...] = ()) -> dict:
-    """``steps`` DEM steps of the running testbed ``bench``, timed by part, alternating in ``rounds`` chunks with as
-    many steps of its bed ``bed`` alone (:func:`smoke_part`). Each round can also step the testbed as many steps in
-    other settings, timed apart: ``half_skin_too``, under the half-skin rule
-    (:class:`~wheelsoil.granular.interaction.HalfSkinRule`; ``half_skin_*`` figures); ``sphere_skins``, with the wheel
-    contact's margin for the spheres' motion (its cap on their allowance) at each of these many skins
-    (``sphere_skins`` figures)."""
-    from wheelsoil.cases import build
-    from wheelsoil.coupling.rig import soil_headroom
-    from wheelsoil.granular.interaction import HalfSkinRule
-
-    # where the time of one coupled step goes, in steady driving, against the soil alone: the same bed in its own bin
-    # (periodic along x where the testbed holds a moving patch's ends instead) at the same step and in the same
-    # domain, without the wheel. The two alternate in ``rounds`` chunks, so that the machine's drift over the minutes
-    # of a run falls on both alike (one block of each in turn gave 1.15, 1.32 and 1.52 in three runs of the same code
-    # on 2026-11-29: the soil alone's own time moved from 2.40 to 3.11 ms between them)
-    c, scene = bench.contact, bench.scene
-    soil = bed.to_scene(headroom=soil_headroom(bed.spec.depth, build.wheel_geometry(case)), arch=arch)
-    soil.time_step = bench.dt
-    soil.step(10)  # compile
-    totals = {"wheel": 0.0, "contact": 0.0, "rebuild": 0.0}
-    _timed(c, "after_drift", totals, "wheel")
-    _timed(c, "add_forces", totals, "contact")
-    _timed(c, "_rebuild", totals, "rebuild")
-    blocks = max(1, steps // (10 * rounds))  # blocks of 10 steps per round
-    default_skins, rule = c.sphere_skins, HalfSkinRule()
-    # the other settings: (name, set up, undo); each round steps every one of them, then today's, then the soil alone
-    others = [("half skin", lambda: scene.interactions.append(rule), lambda: scene.interactions.remove(rule))] \
-        if half_skin_too else []
-    for k in sphere_skins:
-        others.append((f"sphere skins {k:g}", lambda k=k: setattr(c, "sphere_skins", float(k)),
-                       lambda: setattr(c, "sphere_skins", default_skins)))
-    today, tallies = _Tally(), {name: _Tally() for name, _, _ in others}
-    soil_total = soil_cpu = 0.0
-    for _ in range(rounds):
-        other_rounds = {}
-        for name, enter, leave in others:
-            enter()
-            other_rounds[name] = tallies[name].step(bench, blocks, totals)
-            leave()
-        seconds = today.step(bench, blocks, totals)
-        t0, cpu0 = time.perf_counter(), time.process_time()
-        soil.step(10 * blocks)
-        soil_round = time.perf_counter() - t0
-        soil_total += soil_round
-        soil_cpu += time.process_time() - cpu0
-        today.per_round.append(seconds / soil_round)
-        for name, other in other_rounds.items():
-            tallies[name].per_round.append(other / soil_round)
-    out = _figures(today, 10 * blocks * rounds, rounds, soil_total, soil_cpu)
-    out["sphere_skins"] = default_skins
-    n = out["timed_steps"]
-    for name, t in tallies.items():
-        fig = {"ms_per_step": 1e3 * t.seconds / n, "dem_neighbor_rebuilds": t.dem_rebuilds,
-               "ms_per_step_contact_evaluation": 1e3 * (t.parts["contact"] - t.parts["rebuild"]) / n,
-               "coupled_over_soil_alone": t.seconds / soil_total, "coupled_over_soil_alone_per_round": t.per_round,
-               "over_today": t.seconds / today.seconds}
-        if name == "half skin":
-            out.update({f"half_skin_{key}": value for key, value in fig.items()})
-        else:
-            out.setdefault("variants", {})[name] = fig
-    return out
-
-
-def _figures(t: _Tally, n: int, rounds: int, soil_total: float, soil_cpu: float) -> dict:
-    """The figures of :func:`_coupled_against_soil` from the tally of ``n`` coupled steps and the soil alone's wall and
-    CPU time [s] over as many."""
-    parts = t.parts
-    contact_eval = parts["contact"] - parts["rebuild"]
-    contact_eval_cpu = parts["contact_cpu"] - parts["rebuild_cpu"]
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return {
-        "timed_steps": n,
-        "rounds": rounds,
-        "ms_per_step": 1e3 * t.seconds / n,
-        "cores_busy": t.cpu / t.seconds,  # CPU time of all threads / wall time over the timed steps
-        "ms_per_step_soil": 1e3 * (t.seconds - parts["wheel"] - parts["contact"]) / n,
-        "ms_per_step_wheel": 1e3 * parts["wheel"] / n,
-        "ms_per_step_contact_evaluation": 1e3 * contact_eval / n,
-        "ms_per_step_contact_rebuild": 1e3 * parts["rebuild"] / n,
-        # CPU time of all threads per DEM step, by part (the soil: the rest of the step)
-        "cpu_ms_per_step": 1e3 * t.cpu / n,
-        "cpu_ms_per_step_soil": 1e3 * (t.cpu - parts["wheel_cpu"] - parts["contact_cpu"]) / n,
-        "cpu_ms_per_step_wheel": 1e3 * parts["wheel_cpu"] / n,
-        "cpu_ms_per_step_contact_evaluation": 1e3 * contact_eval_cpu / n,
-        "cpu_ms_per_step_contact_rebuild": 1e3 * parts["rebuild_cpu"] / n,
-        "contact_rebuilds": t.wheel_rebuilds,
-        "dem_neighbor_rebuilds": t.dem_rebuilds,
-        "mean_wheel_contacts": t.contacts / (n // 10),
-        "peak_rss_mib": own_peak_rss_mib(),
-        "ms_per_step_soil_alone": 1e3 * soil_total / n,
-        "cpu_ms_per_step_soil_alone": 1e3 * soil_cpu / n,
-        "soil_alone_cores_busy": soil_cpu / soil_total,
-        "coupled_over_soil_alone": t.seconds / soil_total,
-        "coupled_over_soil_alone_per_round": t.per_round,
-        "coupled_over_soil_alone_median": statistics.median(t.per_round),
-        "cores": cores,
-        # the ratio if the coupled step's CPU work were spread over every core with none idle and the soil alone
-        # kept its measured wall time: the floor that scheduling alone cannot go below, for the present cost of
-        # each part (CPU time counts work done, not waiting: Taichi's idle workers sleep)
-        "coupled_over_soil_alone_all_cores_busy": t.cpu / cores / soil_total,
-    }
 
 
 def fe_seed004_part(steps: int, arch) -> dict:
@@ -385,7 +230,7 @@ def cmu_scale(args) -> int:
     runtime.init(args.arch)
     report = {"machine": machine(), "versions": versions(), "command": " ".join(sys.argv)}
     cmu = report["cmu"] = smoke_part(args.steps, args.drive_time, args.arch, COUPLED_PARTS["cmu"], args.rounds,
-                                     tuple(args.set), args.half_skin_too, tuple(args.sphere_skins))
+                                     tuple(args.set), args.half_skin_too, tuple(args.sphere_skins), args.narrow_too)
     print(f"CMU scale ({cmu['case']}): {cmu['particles']} particles, rigid wheel of {cmu['fe_elements']} elements; "
           f"{cmu['wall_seconds_per_simulated_second']:.0f} s wall per simulated s over the protocol; per DEM step "
           f"{cmu['ms_per_step']:.2f} ms = soil {cmu['ms_per_step_soil']:.2f} + wheel {cmu['ms_per_step_wheel']:.2f} + "
@@ -432,13 +277,18 @@ def main(argv=None) -> int:
                          "sphere's allowance half the skin, as before the per-sphere allowance), timed apart")
     ap.add_argument("--sphere-skins", nargs="+", type=float, default=[], metavar="K",
                     help="with --cmu: each round also steps the testbed with the wheel contact's margin for the "
-                         "spheres' motion (its cap on their allowance) at K scene skins, timed apart")
+                         "spheres' motion (the least allowance it leaves a sphere near it) at K scene skins, timed "
+                         "apart")
+    ap.add_argument("--narrow-too", action="store_true",
+                    help="with --cmu: each round also steps the testbed with the allowance as before the widened "
+                         "clearance search and the wheel's per-sphere bound (27 cells, every allowance capped at the "
+                         "wheel candidates' margin), timed apart")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.set and not args.cmu:
         ap.error("--set applies to the CMU part only (--cmu)")
-    if (args.half_skin_too or args.sphere_skins) and not args.cmu:
-        ap.error("--half-skin-too and --sphere-skins apply to the CMU part only (--cmu)")
+    if (args.half_skin_too or args.sphere_skins or args.narrow_too) and not args.cmu:
+        ap.error("--half-skin-too, --sphere-skins and --narrow-too apply to the CMU part only (--cmu)")
     if any(not (math.isfinite(k) and k > 0) for k in args.sphere_skins):
         ap.error(f"--sphere-skins {args.sphere_skins}: each must be a number of skins > 0")
     if args.rounds < 1 or args.steps < 10 * args.rounds:

@@ -45,8 +45,11 @@ half thickness h (the contact surface lies h either side of the facet's mid-surf
   lists: when they need rebuilding for any other reason (the wheel has moved ``wheel_skin``, a restore, new spheres),
   they are rebuilt at once and the scene is asked to rebuild at the next step
   (:meth:`~wheelsoil.granular.Scene.request_neighbor_rebuild`), where they follow. So a sphere has moved from where
-  the candidates saw it no more than since the scene's last rebuild, which :meth:`WheelContact.displacement_cap`
-  bounds by the candidates' margin for it.
+  the candidates saw it no more than since the scene's last rebuild, and each build bounds that motion sphere by
+  sphere: its allowance becomes at most its gap to every facet it does not list less the wheel's own skin
+  (:func:`.candidate_kernels.count_candidates`, :meth:`~wheelsoil.granular.Scene.limit_allowances`). Near the wheel
+  that is the candidates' margin for the spheres' motion (``sphere_skins``); a grain thrown clear of the wheel keeps
+  the larger allowance its own clearance gives it, up to :data:`CLEARANCE_CELLS` cells more.
 """
 
 from __future__ import annotations
@@ -70,6 +73,7 @@ from wheelsoil.granular.scene import Interaction, Scene
 from wheelsoil.granular.neighbors import exclusive_scan
 from wheelsoil.taichi_types import vec3
 
+from . import candidate_kernels as ck
 from . import kernels as k
 from .surface import ContactSurface
 from .surface_arrays import SurfaceArrays
@@ -103,11 +107,15 @@ def _grown(arrays: dict, name: str, dtype, size: int, shape_tail: tuple = ()):
     return arr
 
 
-#: The candidates' margin for the spheres' motion between two rebuilds, in the scene's skins: the most a sphere may
-#: move before the scene rebuilds (a sphere clear of its neighbours may otherwise move up to half its clearance;
+#: The candidates' margin for the spheres' motion between two rebuilds, in the scene's skins: the least allowance the
+#: wheel leaves a sphere near it (a sphere clear of its neighbours may otherwise move up to half its clearance;
 #: :func:`wheelsoil.granular.neighbors.displacement_allowance`). Two skins: four times the plain Verlet half skin,
 #: for a margin 6/5 of the former one (skin + 4 skins of the wheel's own).
 SPHERE_SKINS = 2.0
+#: How far beyond the candidates' reach, in grid cells, a sphere's cell is checked for facets at all
+#: (:func:`.candidate_kernels.mark_near_cells`): a sphere in a cell with none within that reach may move that much
+#: further before the scene rebuilds, so that the wheel does not hold back a grain it has thrown clear.
+CLEARANCE_CELLS = 2
 
 
 class WheelContact(Interaction):
@@ -118,13 +126,11 @@ class WheelContact(Interaction):
     structure: the wheel (flexible or ``rigid=True``), advanced by this interface every DEM step.
     soil: the particles' material (E, nu) for the effective moduli.
     pair: soil--wheel restitution, static and rolling friction (default: seed 004 Table 1 soil--steel).
-    advance_structure: advance the structure over each DEM step (``False``: the wheel is held where
-        it is, e.g. to measure contact forces on a frozen wheel).
+    advance_structure: advance the structure over each DEM step (``False``: held where it is, e.g. a frozen wheel).
     health_every: steps between the structure's health checks.
-    wheel_skin: how far [m] the wheel's surface may move before the candidate lists are rebuilt
-        (default: four times the scene's skin); candidates are kept within the sphere's reach plus
-        ``sphere_skins`` (default :data:`SPHERE_SKINS`) of the scene's skin, the spheres' motion, plus this (module
-        docstring, *candidates*; a change of the attribute takes effect at the scene's next rebuild).
+    wheel_skin, sphere_skins: how far [m] the wheel's surface may move before the candidate lists are rebuilt (default:
+        four times the scene's skin), and the candidates' margin for the spheres' motion, in scene skins (default
+        :data:`SPHERE_SKINS`); module docstring, *candidates* (a change takes effect at the scene's next rebuild).
     """
 
     def __init__(
@@ -193,6 +199,7 @@ class WheelContact(Interaction):
         a["hist_roll"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
         a["hist_count"] = ti.ndarray(ti.i32, shape=n)
         a["hist_count"].fill(0)
+        a["wheel_gap"] = ti.ndarray(ti.f64, shape=n)
         self._scene_key = (id(scene), n)
         self._n_active = 0
         self._need_rebuild = True
@@ -206,33 +213,38 @@ class WheelContact(Interaction):
         # the soil's own grid (:meth:`Scene.grid`): a facet is binned into every cell its box grown by r_max + skin
         # meets, and a sphere reads only its cell, so any cell edge works
         grid = scene.grid
-        self.skin = self.displacement_cap(scene) + self.wheel_skin  # candidate margin
+        self.skin = self.sphere_skins * scene.skin + self.wheel_skin  # candidate margin
         if "cell_count" not in a or a["cell_count"].shape[0] != grid.n_cells:
             a["cell_count"] = ti.ndarray(ti.i32, shape=grid.n_cells)
             a["cell_start"] = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
+            a["near"] = ti.ndarray(ti.i32, shape=grid.n_cells)
         origin, inv_cell, dims = grid.kernel_args()
         pad = self.r_max + self.skin
-        k.facet_cell_ranges(w.x, d.triangles, d.half_thickness, sf.n_facets, pad, origin, inv_cell, dims,
+        far_pad = pad + CLEARANCE_CELLS * grid.cell
+        ck.mark_near_cells(w.x, d.triangles, d.half_thickness, sf.n_facets, far_pad, origin, inv_cell, dims, a["near"])
+        ck.facet_cell_ranges(w.x, d.triangles, d.half_thickness, sf.n_facets, pad, origin, inv_cell, dims,
                             d.facet_lo, d.facet_hi, a["cell_count"])
         total = exclusive_scan(a["cell_count"], a["cell_start"])
         cell_fill = self._buffer("cell_fill", ti.i32, a["cell_count"].shape[0])
         cell_facets = self._buffer("cell_facets", ti.i32, max(total, 1))
-        k.fill_facet_cells(sf.n_facets, dims, d.facet_lo, d.facet_hi, a["cell_start"], cell_fill, cell_facets)
-        k.count_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
-                           w.x, d.triangles, d.half_thickness, a["count"], a["hist_count"])
+        ck.fill_facet_cells(sf.n_facets, dims, d.facet_lo, d.facet_hi, a["cell_start"], cell_fill, cell_facets)
+        ck.count_candidates(ds.x, ds.radius, self.skin, pad, far_pad, origin, inv_cell, dims, a["cell_start"],
+                           cell_facets, a["near"], w.x, d.triangles, d.half_thickness, a["count"], a["hist_count"],
+                           a["wheel_gap"])
+        scene.limit_allowances(a["wheel_gap"], self.wheel_skin)
         n_cand = exclusive_scan(a["count"], a["start"])
         cand = self._buffer("cand", ti.i32, max(n_cand, 1))
-        k.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
+        ck.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
                           w.x, d.triangles, d.half_thickness, a["start"], cand)
         facet_entries = self._buffer("facet_entries", ti.i32, max(n_cand, 1))
-        self._n_active = k.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, d.facet_start,
+        self._n_active = ck.index_active(a["count"], a["start"], a["active"], sf.n_facets, cand, d.facet_start,
                                         d.facet_fill, facet_entries)
         for name, dtype in (("code", ti.i32), ("keep", ti.i32), ("overlap", ti.f64), ("stiffness", ti.f64), ("normal", vec3),
                             ("f_wheel", vec3), ("m_wheel", vec3), ("xi_new", vec3), ("roll_new", vec3)):
             self._buffer(name, dtype, max(n_cand, 1))
         self._buffer("bary", ti.f64, max(n_cand, 1), shape_tail=(3,))
         self._arrays["keep"].fill(0)
-        k.copy_node_positions(w.x, d.nodes, d.node_reference)
+        ck.copy_node_positions(w.x, d.nodes, d.node_reference)
         self._seen_rebuilds = scene.neighbor_rebuilds
         self._need_rebuild = False
         self.rebuilds += 1
@@ -261,10 +273,6 @@ class WheelContact(Interaction):
         if self._stats[0] > (0.8 * self.wheel_skin) ** 2:
             scene.request_neighbor_rebuild()
         return self._n_contacts
-
-    def displacement_cap(self, scene: Scene) -> float:
-        """The most [m] a sphere may move between the scene's rebuilds: ``sphere_skins`` of its skin."""
-        return self.sphere_skins * scene.skin
 
     def _launch_contacts(self, dt: float) -> None:
         """One evaluation of every contact (:func:`.kernels.wheel_contacts`, as a compute graph); its array

@@ -1,13 +1,8 @@
 """Taichi kernels of the particle--wheel contact interface (see :mod:`.contact` for the physics).
 
-Two kinds of work:
+The candidate lists are rebuilt by :mod:`.candidate_kernels`; here is the work of
 
-* *Rebuild* (when particles or the wheel have moved far enough): bin the contact facets into the
-  scene's uniform grid (:mod:`wheelsoil.granular.grid`, the cells the soil's neighbour search uses),
-  list for every particle the facets within its reach plus a skin (its *candidates*, sorted by facet
-  so that results do not depend on thread scheduling), compact the particles that have candidates
-  into an *active* list, and transpose the candidate list per facet.
-* *Every step* (:func:`wheel_contacts`, one launch), in phases, each a Taichi function:
+* *every step* (:func:`wheel_contacts`, one launch), in phases, each a Taichi function:
   (A) :func:`candidate_geometry` -- per active particle, classify each candidate by the Voronoi region of
   its closest point (face, edge, vertex); (B) :func:`counted_once` -- keep each physical contact once;
   (C) the Hertz--Mindlin law with the contact's tangential history (:func:`matched_history`), force and
@@ -22,145 +17,13 @@ import taichi as ti
 
 from wheelsoil.graph_launch import GraphKernel
 from wheelsoil.granular.contact import hertz_mindlin
-from wheelsoil.granular.grid import cell_coords, cell_index
-from wheelsoil.granular.neighbors import sort_run
-from wheelsoil.taichi_types import ivec3, nd_f64, nd_f64_2d, nd_i32, nd_i32_2d, nd_ivec3, nd_vec3, nd_vec3_2d, vec3
+from wheelsoil.taichi_types import nd_f64, nd_f64_2d, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
 
+from .candidate_kernels import corners as _corners
 from .closest_point import EDGE_AB, EDGE_CA, FACE, VERTEX_A, closest_point_on_triangle
 
 #: Rows of the resultant array: force and moment of this step, their running sums, sample count.
 RES_FORCE, RES_MOMENT, RES_FORCE_SUM, RES_MOMENT_SUM, RES_SAMPLES = range(5)
-
-
-@ti.func
-def _corners(xw: ti.template(), tri: ti.template(), s: ti.i32):
-    return xw[tri[s, 0]], xw[tri[s, 1]], xw[tri[s, 2]]
-
-
-@ti.kernel
-def facet_cell_ranges(
-    xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, n_facets: ti.i32, pad: ti.f64, origin: vec3, inv_cell: ti.f64,
-    dims: ivec3, lo: nd_ivec3, hi: nd_ivec3, cell_count: nd_i32,
-):
-    """Cell range of every facet's box grown by ``pad`` + half thickness; count facets per cell."""
-    for c in cell_count:
-        cell_count[c] = 0
-    for s in range(n_facets):
-        a, b, c = _corners(xw, tri, s)
-        grow = pad + half_t[s]
-        mn = ti.min(a, b, c) - grow
-        mx = ti.max(a, b, c) + grow
-        top = origin + ti.cast(dims, ti.f64) / inv_cell
-        l = ivec3(1, 1, 1)
-        h = ivec3(0, 0, 0)  # empty unless the box meets the grid
-        if (mx >= origin).all() and (mn <= top).all():
-            l = cell_coords(mn, origin, inv_cell, dims)
-            h = cell_coords(mx, origin, inv_cell, dims)
-            for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
-                ti.atomic_add(cell_count[cell_index(ivec3(i, j, k), dims)], 1)
-        lo[s] = l
-        hi[s] = h
-
-
-@ti.kernel
-def fill_facet_cells(
-    n_facets: ti.i32, dims: ivec3, lo: nd_ivec3, hi: nd_ivec3, cell_start: nd_i32, cell_fill: nd_i32,
-    cell_facets: nd_i32,
-):
-    for c in cell_fill:
-        cell_fill[c] = 0
-    for s in range(n_facets):
-        l = lo[s]
-        h = hi[s]
-        for i, j, k in ti.ndrange((l[0], h[0] + 1), (l[1], h[1] + 1), (l[2], h[2] + 1)):
-            c = cell_index(ivec3(i, j, k), dims)
-            cell_facets[cell_start[c] + ti.atomic_add(cell_fill[c], 1)] = s
-
-
-@ti.func
-def _within_reach(p: vec3, reach: ti.f64, xw: ti.template(), tri: ti.template(), s: ti.i32) -> ti.i32:
-    a, b, c = _corners(xw, tri, s)
-    bary, _ = closest_point_on_triangle(p, a, b, c)
-    q = bary[0] * a + bary[1] * b + bary[2] * c
-    return ti.cast((p - q).norm_sqr() < reach * reach, ti.i32)
-
-
-@ti.kernel
-def count_candidates(
-    x: nd_vec3, radius: nd_f64, skin: ti.f64, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_start: nd_i32,
-    cell_facets: nd_i32, xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, count: nd_i32, hist_count: nd_i32,
-) -> ti.i32:
-    """Number of facets within radius + half thickness + skin of each particle; returns the largest.
-
-    A particle with no candidates forgets its wheel-contact history (it has left the wheel)."""
-    most = 0
-    for i in x:
-        c = cell_index(cell_coords(x[i], origin, inv_cell, dims), dims)
-        k = 0
-        for q in range(cell_start[c], cell_start[c + 1]):
-            s = cell_facets[q]
-            k += _within_reach(x[i], radius[i] + half_t[s] + skin, xw, tri, s)
-        count[i] = k
-        if k == 0:
-            hist_count[i] = 0
-        ti.atomic_max(most, k)
-    return most
-
-
-@ti.kernel
-def fill_candidates(
-    x: nd_vec3, radius: nd_f64, skin: ti.f64, origin: vec3, inv_cell: ti.f64, dims: ivec3, cell_start: nd_i32,
-    cell_facets: nd_i32, xw: nd_vec3, tri: nd_i32_2d, half_t: nd_f64, start: nd_i32, cand: nd_i32,
-):
-    """Write each particle's candidate facets, sorted ascending (:func:`wheelsoil.granular.neighbors.sort_run`)."""
-    for i in x:
-        e0 = start[i]
-        e1 = start[i + 1]
-        if e1 > e0:
-            c = cell_index(cell_coords(x[i], origin, inv_cell, dims), dims)
-            k = e0
-            for q in range(cell_start[c], cell_start[c + 1]):
-                s = cell_facets[q]
-                if _within_reach(x[i], radius[i] + half_t[s] + skin, xw, tri, s):
-                    cand[k] = s
-                    k += 1
-            sort_run(cand, e0, e1)
-
-
-@ti.kernel
-def index_active(
-    count: nd_i32, start: nd_i32, active: nd_i32, n_facets: ti.i32, cand: nd_i32, facet_start: nd_i32,
-    facet_fill: nd_i32, facet_entries: nd_i32,
-) -> ti.i32:
-    """Compact the particles with candidates into ``active`` and list every facet's candidate entries
-    (serial: the order is deterministic). Returns the number of active particles."""
-    n_active = 0
-    ti.loop_config(serialize=True)
-    for _ in range(1):
-        for s in range(n_facets + 1):
-            facet_start[s] = 0
-        for i in range(count.shape[0]):
-            if count[i] > 0:
-                active[n_active] = i
-                n_active += 1
-                for e in range(start[i], start[i + 1]):
-                    facet_start[cand[e] + 1] += 1
-        for s in range(n_facets):
-            facet_start[s + 1] += facet_start[s]
-            facet_fill[s] = facet_start[s]
-        for a in range(n_active):
-            i = active[a]
-            for e in range(start[i], start[i + 1]):
-                s = cand[e]
-                facet_entries[facet_fill[s]] = e
-                facet_fill[s] += 1
-    return n_active
-
-
-@ti.kernel
-def copy_node_positions(xw: nd_vec3, nodes: nd_i32, ref: nd_vec3):
-    for u in nodes:
-        ref[u] = xw[nodes[u]]
 
 
 @ti.func

@@ -15,11 +15,14 @@ class Interaction:
       The one-launch step that follows adds them to the sphere--sphere and sphere--wall forces
       (:mod:`.fused_step`).
 
-    A body that keeps candidate lists of spheres near it, built with a margin for the spheres' motion, defines
-    ``displacement_cap(scene) -> float``: that margin [m], the most a sphere may move between two of the scene's
-    neighbour rebuilds (:meth:`~.scene.Scene.displacement_cap`; otherwise a sphere clear of its neighbours may move
-    up to half its clearance). It builds its lists in a step in which the scene rebuilt (``scene.neighbor_rebuilds``
-    changed), or else calls ``scene.request_neighbor_rebuild()`` so that the next step does.
+    A body that keeps candidate lists of spheres near it, built with a margin for the spheres' motion, bounds how far
+    a sphere may move between two of the scene's neighbour rebuilds (otherwise a sphere clear of its neighbours may
+    move up to half its clearance), in one of two ways: sphere by sphere, by calling
+    ``scene.limit_allowances(gap, less)`` with each sphere's gap to what it did not list each time it builds its
+    lists (:meth:`~.scene.Scene.limit_allowances`; the wheel contact does), or for all alike, by defining
+    ``displacement_cap(scene) -> float``: the margin [m] (:meth:`~.scene.Scene.displacement_cap`). It builds its
+    lists in a step in which the scene rebuilt (``scene.neighbor_rebuilds`` changed), or else calls
+    ``scene.request_neighbor_rebuild()`` so that the next step does.
 
     An optional ``renumber(scene, old_of_new)`` hears that sphere k is now the former sphere ``old_of_new[k]``
     (-1: a new one) after spheres were added or removed.
@@ -38,11 +41,12 @@ class Interaction:
         return 0
 
 
-class HalfSkinRule(Interaction):
-    """No body, no force: caps every sphere's displacement allowance at half the skin, the plain Verlet test (a
-    rebuild once any sphere has moved half the skin) that the neighbour lists used before each sphere had its own
-    allowance (:func:`.neighbors.displacement_allowance`). The trajectory is the same either way; this is for
-    comparing the rebuild counts and costs in one run (``scene.interactions.append(HalfSkinRule())``)."""
+class SkinCap(Interaction):
+    """No body, no force: caps every sphere's displacement allowance at ``skins`` of the scene's skin, for comparing
+    rebuild rules in one run (the trajectory is the same under any; ``scene.interactions.append(SkinCap(2.0))``)."""
+
+    def __init__(self, skins: float) -> None:
+        self.skins = float(skins)
 
     def after_drift(self, scene, dt: float) -> None:
         pass
@@ -51,5 +55,14 @@ class HalfSkinRule(Interaction):
         return 0
 
     def displacement_cap(self, scene) -> float:
-        """Half the scene's skin [m]."""
-        return 0.5 * scene.skin
+        """``skins`` of the scene's skin [m]."""
+        return self.skins * scene.skin
+
+
+class HalfSkinRule(SkinCap):
+    """Every sphere's displacement allowance capped at half the skin: the plain Verlet test (a rebuild once any sphere
+    has moved half the skin) that the neighbour lists used before each sphere had its own allowance
+    (:func:`.neighbors.displacement_allowance`)."""
+
+    def __init__(self) -> None:
+        super().__init__(0.5)

@@ -98,8 +98,10 @@ class NeighborList:
         self.clearance = ti.ndarray(ti.f64, shape=max(n, 1))
         self.allowance_inv2 = ti.ndarray(ti.f64, shape=max(n, 1))
         self.allowance_inv2.fill(1e30)
-        #: the cap on every allowance at the last rebuild [m] (:meth:`rebuild`)
+        #: the cap on every allowance at the last rebuild [m], and the spheres whose search was widened then
+        #: (:meth:`rebuild`)
         self.cap = math.inf
+        self.widened = 0
         self.cell_of = ti.ndarray(ti.i32, shape=n)
         self.cell_count = ti.ndarray(ti.i32, shape=grid.n_cells)
         self.cell_start = ti.ndarray(ti.i32, shape=grid.n_cells + 1)
@@ -118,10 +120,11 @@ class NeighborList:
         self.nbr = ti.ndarray(ti.i32, shape=(self.n, width))
         self.count = ti.ndarray(ti.i32, shape=self.n)
 
-    def rebuild(self, p: ParticleArrays, walls: WallArrays, cap: float = math.inf) -> None:
+    def rebuild(self, p: ParticleArrays, walls: WallArrays, cap: float = math.inf, horizon: float = 0.0) -> None:
         """Rebin the spheres, rebuild the rows and the pair list (history carried over), list the walls in reach,
         give every sphere its displacement allowance (at most ``cap`` [m]), and take the positions as the new
-        Verlet reference."""
+        Verlet reference. A sphere in the air that would cross its allowance within ``horizon`` [s] at its speed
+        searches further for its clearance (:func:`.neighbors.widen_clearance`; ``widened`` counts them)."""
         grid = self.grid
         if grid.period > 0.0:
             neighbors.wrap_positions(p.x, p.x_r, grid.origin[0], grid.period)
@@ -166,6 +169,11 @@ class NeighborList:
         neighbors.fill_reverse_index(new.j, n_pairs, self.rev_start, self.cursor, new.rev_pair, new.rev)
         new.partner_slot.fill(0.0)
         self.pairs, self.spare, self.n_pairs = new, old, n_pairs
+        self.widened = 0
+        if horizon > 0.0:
+            self.widened = neighbors.widen_clearance(p.x, p.v, p.r, self.cell_start, self.sorted_ids, origin, inv_cell,
+                                                     dims, self.skin, self.r_max, grid.period, grid.inv_period,
+                                                     float(horizon), self.clearance)
         neighbors.near_walls(p.x, p.r, walls.point, walls.normal, self.skin, walls.near, self.clearance)
         self.cap = float(cap)
         neighbors.displacement_allowance(self.clearance, self.skin, min(self.cap, 1e300), self.allowance_inv2)

@@ -11,7 +11,9 @@ pair list to the new one (a merge of two sorted lists), so contacts survive any 
 A reverse index gives every pair its place in its partner's run of slots (runs by partner, sorted
 by owner), where the force pass writes what the pair exerts on the partner (:mod:`.forces`).
 Walls get a list of their own at each rebuild: a bit mask per particle of the walls within reach
-(:func:`near_walls`).
+(:func:`near_walls`). Each sphere also gets its clearance to whatever it does not list, from which its displacement
+allowance until the next rebuild follows (:func:`displacement_allowance`; a grain in the air searches further:
+:func:`widen_clearance`).
 """
 
 
@@ -40,6 +42,46 @@ def nearest_image(d: vec3, period: ti.f64, inv_period: ti.f64) -> vec3:
     Allen & Tildesley, *Computer Simulation of Liquids*, sec. 1.5.2): d_x - L round(d_x / L). With
     period = inv_period = 0 (no periodicity) it returns d unchanged, to the bit."""
     return vec3(d[0] - period * ti.round(d[0] * inv_period), d[1], d[2])
+
+
+@ti.func
+def block_cell(cc: ivec3, dims: ivec3, period: ti.f64) -> ti.i32:
+    """Flat index of cell ``cc`` of a searched block, wrapped around along a periodic x (``period`` > 0); -1 where
+    the cell lies beyond the grid."""
+    k = cc
+    if period > 0.0:
+        k[0] = ((cc[0] % dims[0]) + dims[0]) % dims[0]
+    cid = -1
+    if (k >= 0).all() and (k < dims).all():
+        cid = cell_index(k, dims)
+    return cid
+
+
+#: Where no face of a searched block bounds a sphere's clearance (the block holds every cell) [m].
+UNBOUNDED = 1e30
+
+
+@ti.func
+def block_bound(xi: vec3, c: ivec3, cells: ti.i32, origin: vec3, inv_cell: ti.f64, dims: ivec3, period: ti.f64,
+                radii: ti.f64) -> ti.f64:
+    """A lower bound [m] on the gap from the sphere at ``xi`` (in cell ``c``, clamped to the grid) to every sphere
+    outside the block of cells c - ``cells`` .. c + ``cells`` (the grid's cells within it): the distance from xi to
+    the block's nearest face, less ``radii`` (r_i + r_max), and at least 0.
+
+    A face on or beyond the grid's boundary does not count: a sphere beyond the grid is binned into the boundary
+    layer (:func:`.grid.cell_coords`), which the block holds on that side, so a sphere outside the block lies beyond
+    one of the block's other faces along that axis (whether or not it was clamped). Along a periodic x (``period``
+    > 0) the cells wrap, and the x faces count unless the block holds every column. So a grain thrown above the
+    grid's top is bounded by the faces below and beside it only. :data:`UNBOUNDED` where no face counts."""
+    u = (xi - origin) * inv_cell - ti.cast(c, ti.f64)  # xi's place in its cell [cells] (outside [0, 1) if clamped)
+    nearest = UNBOUNDED * inv_cell
+    for k in ti.static(range(3)):
+        wraps = period > 0.0 and k == 0
+        if (wraps and 2 * cells + 1 < dims[0]) or (not wraps and c[k] - cells > 0):
+            nearest = ti.min(nearest, u[k] + cells)
+        if (wraps and 2 * cells + 1 < dims[0]) or (not wraps and c[k] + cells < dims[k] - 1):
+            nearest = ti.min(nearest, cells + 1.0 - u[k])
+    return ti.min(ti.max(nearest / inv_cell - radii, 0.0), UNBOUNDED)
 
 
 @ti.kernel
@@ -109,10 +151,8 @@ def build_neighbor_lists(
     """Fill each particle's row with the partners j > i closer than r_i + r_j + skin, sorted by j, and
     ``clearance[i]`` [m] with a lower bound on the gap d_ij - r_i - r_j from i to every sphere listed with it by
     neither row (j > i in i's row, j < i in j's row): the least such gap among the spheres of the 27 cells searched,
-    and for those beyond them the distance from x_i to the searched block's faces less r_i and ``r_max`` (the
-    largest radius). It is at least ``skin`` wherever i lies inside the grid; a sphere clamped into a boundary cell
-    from outside may get less (down to 0), which only makes its allowance the plain half skin
-    (:func:`displacement_allowance`).
+    and for those beyond them :func:`block_bound`. It is at least ``skin``: a sphere beyond the grid (a grain thrown
+    above its top) is clamped into a boundary cell, and the block's faces on the grid's boundary do not bound it.
 
     ``period`` > 0 makes the domain periodic along x with that length (``inv_period`` = 1 / period;
     both 0 otherwise): the cells wrap around in x (the grid must have at least 3 cells along x and a
@@ -126,17 +166,11 @@ def build_neighbor_lists(
         xi = x[i]
         ri = radius[i]
         c = cell_coords(xi, origin, inv_cell, dims)
-        # x_i's place in its cell [cells]; the searched block spans [-1, 2) of it on every axis
-        u = (xi - origin) * inv_cell - ti.cast(c, ti.f64)
-        to_faces = ti.min((u + 1.0).min(), (2.0 - u).min()) / inv_cell
-        clear = ti.max(to_faces - ri - r_max, 0.0)
+        clear = block_bound(xi, c, 1, origin, inv_cell, dims, period, ri + r_max)
         count = 0
         for dz, dy, dx in ti.ndrange((-1, 2), (-1, 2), (-1, 2)):
-            cc = c + ivec3(dx, dy, dz)
-            if period > 0.0:
-                cc[0] = (cc[0] + dims[0]) % dims[0]
-            if (cc >= 0).all() and (cc < dims).all():
-                cid = cell_index(cc, dims)
+            cid = block_cell(c + ivec3(dx, dy, dz), dims, period)
+            if cid >= 0:
                 for s in range(cell_start[cid], cell_start[cid + 1]):
                     j = sorted_ids[s]
                     if j != i:
@@ -156,6 +190,62 @@ def build_neighbor_lists(
         clearance[i] = clear
         ti.atomic_max(most, count)
     return most
+
+
+#: How far the widened search of :func:`widen_clearance` looks, in cells either side of the sphere's own.
+WIDE_CELLS = 3
+
+
+@ti.kernel
+def widen_clearance(
+    x: nd_vec3,
+    v: nd_vec3,
+    radius: nd_f64,
+    cell_start: nd_i32,
+    sorted_ids: nd_i32,
+    origin: vec3,
+    inv_cell: ti.f64,
+    dims: ivec3,
+    skin: ti.f64,
+    r_max: ti.f64,
+    period: ti.f64,
+    inv_period: ti.f64,
+    horizon: ti.f64,
+    clearance: nd_f64,
+) -> ti.i32:
+    """Search the block of (2 :data:`WIDE_CELLS` + 1)^3 cells for the spheres the 27 cells could not bound and that
+    need it: those whose clearance (from :func:`build_neighbor_lists`) is the 27-cell block's bound itself (no
+    unlisted sphere nearer in it: a grain in the air) and which, at their speed |v_i| [m/s], would cross their
+    allowance (half that clearance) within ``horizon`` [s]. For them ``clearance[i]`` [m] becomes the least gap to an
+    unlisted sphere in the wide block, or the wide block's bound (:func:`block_bound`) if less, which is again a
+    lower bound on the gap to every unlisted sphere. A grain thrown up no longer asks for a rebuild every few steps;
+    a sphere in the bed keeps its 27-cell clearance (searching 343 cells for each would cost more than the row
+    search). Returns the number of spheres widened."""
+    widened = 0
+    for i in x:
+        xi = x[i]
+        ri = radius[i]
+        c = cell_coords(xi, origin, inv_cell, dims)
+        clear = clearance[i]
+        if clear >= block_bound(xi, c, 1, origin, inv_cell, dims, period, ri + r_max) and (
+            v[i].norm() * horizon > 0.5 * ti.max(skin, clear)
+        ):
+            wide = block_bound(xi, c, WIDE_CELLS, origin, inv_cell, dims, period, ri + r_max)
+            for dz, dy, dx in ti.ndrange((-WIDE_CELLS, WIDE_CELLS + 1), (-WIDE_CELLS, WIDE_CELLS + 1),
+                                         (-WIDE_CELLS, WIDE_CELLS + 1)):
+                cid = block_cell(c + ivec3(dx, dy, dz), dims, period)
+                if cid >= 0:
+                    for s in range(cell_start[cid], cell_start[cid + 1]):
+                        j = sorted_ids[s]
+                        if j != i:
+                            touch = ri + radius[j]
+                            reach = touch + skin
+                            d2 = nearest_image(x[j] - xi, period, inv_period).norm_sqr()
+                            if d2 >= reach * reach and d2 < (wide + touch) * (wide + touch):
+                                wide = ti.sqrt(d2) - touch
+            clearance[i] = wide
+            ti.atomic_add(widened, 1)
+    return widened
 
 
 @ti.kernel
@@ -198,6 +288,17 @@ def displacement_allowance(clearance: nd_f64, skin: ti.f64, cap: ti.f64, allowan
     for i in clearance:
         a = ti.min(0.5 * ti.max(skin, clearance[i]), cap)
         allowance_inv2[i] = 1.0 / (a * a)
+
+
+@ti.kernel
+def limit_allowance(gap: nd_f64, less: ti.f64, allowance_inv2: nd_f64):
+    """Lower each sphere's allowance to ``gap[i]`` - ``less`` [m] where that is less (``allowance_inv2`` holds
+    1 / a_i^2 [1/m^2]): a body that listed the spheres near it gives each one the gap [m] to what it did not list,
+    and ``less`` [m] is how far the body itself may move before it lists them again
+    (:meth:`~.scene.Scene.limit_allowances`)."""
+    for i in allowance_inv2:
+        a = gap[i] - less
+        allowance_inv2[i] = ti.max(allowance_inv2[i], 1.0 / (a * a))
 
 
 @ti.func

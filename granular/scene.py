@@ -23,7 +23,6 @@ are mixed in; the class itself keeps the clock, the time step and the stepping s
 
 from __future__ import annotations
 
-import math
 
 from typing import Callable
 
@@ -40,6 +39,7 @@ from .scene_domain import SceneDomain
 from .scene_edits import SceneEdits
 from .scene_input import as_vector, check_scene_options
 from .scene_readout import SceneReadout
+from .scene_rebuilds import WIDEN_HORIZON_STEPS, SceneRebuilds
 from .sphere_state import SphereState
 from .timestep import TimeStepEstimate, estimate_time_step
 from .walls import MAX_WALLS, Wall
@@ -47,7 +47,7 @@ from .walls import MAX_WALLS, Wall
 __all__ = ["DeviceParts", "DeviceState", "Interaction", "MAX_WALLS", "Scene", "Wall"]
 
 
-class Scene(SceneEdits, SceneReadout):
+class Scene(SceneEdits, SceneReadout, SceneRebuilds):
     """A DEM scene of polydisperse spheres of one material and any number of planar walls.
 
     Parameters
@@ -120,6 +120,9 @@ class Scene(SceneEdits, SceneReadout):
         #: Run the force pass and the integration as one launch per step when nothing else acts on
         #: the particles (granular.fused_step; the same arithmetic, fewer passes over memory).
         self.fuse_steps = True
+        #: steps ahead a sphere in the air looks, at its speed, for a wider search of its clearance at a rebuild
+        #: (0: none; :data:`WIDEN_HORIZON_STEPS`)
+        self.widen_steps = WIDEN_HORIZON_STEPS
         # host copy of the state (authoritative while self._device is None)
         self._spheres = SphereState.empty()  # the host state (the device's while it steps: _to_host)
         self._hist: ContactHistory | None = None  # the contacts' memory (host copy; None: no contact yet)
@@ -263,27 +266,6 @@ class Scene(SceneEdits, SceneReadout):
                                           self.skin, self._cell_request)
         self._rebuild_neighbors()
         return self._device
-
-    def _rebuild_neighbors(self) -> None:
-        device = self._device
-        device.neighbor_list.rebuild(device.particles, device.walls, self.displacement_cap())
-        self.neighbor_rebuilds += 1
-        self._rebuild_requested = False
-
-    def request_neighbor_rebuild(self) -> None:
-        """Rebuild the neighbour lists at the start of the next step (after its drift, before the interactions
-        evaluate their contacts): an interaction asks this when its own candidate lists need rebuilding, so that
-        every candidate build shares the scene's Verlet reference (:meth:`displacement_cap`)."""
-        self._rebuild_requested = True
-
-    def displacement_cap(self) -> float:
-        """The most [m] any sphere may move between two neighbour rebuilds: the least ``displacement_cap(scene)``
-        of the interactions that bound it (an interaction whose candidate lists were built with a margin for the
-        spheres' motion since the last rebuild), infinite when none does. Each sphere's own allowance is its
-        clearance at the rebuild, halved (:func:`.neighbors.displacement_allowance`), within this cap."""
-        caps = [float(body.displacement_cap(self)) for body in self.interactions
-                if callable(getattr(body, "displacement_cap", None))]
-        return min(caps, default=math.inf)
 
     def _to_host(self) -> None:
         """Copy the device state back to NumPy and drop the device arrays (before structural edits)."""

@@ -4,7 +4,8 @@ The Verlet lists must hold every pair that can touch before the next rebuild. Wi
 clearance (its gap to the nearest sphere or wall it does not list) instead of half the skin, a grain thrown clear
 of the bed moves further between rebuilds; these tests check, against brute force, that the clearance never exceeds
 a true gap, that the lists stay complete (the trajectory is the one with lists rebuilt at every step, to the bit),
-and that a thrown grain no longer sets the rebuild rate.
+and that a thrown grain no longer sets the rebuild rate: its search widens beyond the 27 cells (also above the grid's
+top, where the grid clamps it), and a body's candidate lists bound each sphere by its own gap to what they do not list.
 """
 
 import functools
@@ -141,8 +142,9 @@ def test_the_cap_bounds_every_allowance_and_a_request_rebuilds_at_the_next_step(
 def test_a_moving_body_still_meets_every_grain_thrown_at_it(seed):
     """A rigid plate sweeping over the bed at 0.5 m/s while grains are thrown up into it: its candidate lists are
     rebuilt only with the scene's (and ask for a scene rebuild when the plate has moved), and the spheres' allowance
-    is capped by the candidates' margin for them, so the run is the one with everything rebuilt at every step."""
-    from wheelsoil.coupling.contact import SPHERE_SKINS, WheelContact
+    is bounded by each one's gap to the facets it does not list less the plate's own skin, so the run is the one
+    with everything rebuilt at every step."""
+    from wheelsoil.coupling.contact import WheelContact
     from wheelsoil.flexwheel.material import SEED004_WHEEL
     from wheelsoil.flexwheel.mesh import StructureMesh
     from wheelsoil.flexwheel.shapes import strip
@@ -170,11 +172,90 @@ def test_a_moving_body_still_meets_every_grain_thrown_at_it(seed):
             hits += contact.contact_count
         runs[rule] = (s.positions, s.velocities, s.neighbor_rebuilds - before, hits)
         if rule == "allowance":
-            cap = 1.0 / np.sqrt(s.device.neighbor_list.allowance_inv2.to_numpy())
-            assert cap.max() == pytest.approx(SPHERE_SKINS * s.skin)  # a thrown grain reaches the cap
+            _check_wheel_gaps(s, contact, plate)
     ref, new = runs["every step"], runs["allowance"]
     assert ref[3] > 20  # sphere--plate contacts over the run, counted step by step
     assert new[3] == ref[3]
     np.testing.assert_allclose(new[0], ref[0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(new[1], ref[1], rtol=0, atol=1e-9)
     assert new[2] < 0.5 * ref[2]
+
+
+def _check_wheel_gaps(s: Scene, contact, plate) -> None:
+    """After a rebuild of both lists: each sphere's gap to the plate's facets it does not list (the wheel contact's
+    bound) is no more than the true gap to the plate for a sphere that lists none (brute force: the facets are the
+    flat rectangle the plate covers), every allowance is within it less the plate's skin, and a grain thrown clear
+    of the plate may move further than the candidates' margin."""
+    from wheelsoil.coupling.contact import SPHERE_SKINS
+
+    s.request_neighbor_rebuild()
+    s.step(1)
+    x = s.device.particles.x_ref.to_numpy()
+    r = s.radii
+    nodes = plate.arrays.x.to_numpy()
+    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+    h = 0.5 * float(np.max(plate.mesh.thickness))  # one thickness over the plate
+    true = np.linalg.norm(x - np.clip(x, lo, hi), axis=1) - r - h
+    gap = contact._arrays["wheel_gap"].to_numpy()
+    listless = contact._arrays["count"].to_numpy() == 0
+    assert listless.sum() > 100
+    assert np.all(gap[listless] <= true[listless] * (1 + 1e-12))
+    allowance = 1.0 / np.sqrt(s.device.neighbor_list.allowance_inv2.to_numpy())
+    assert np.all(allowance <= (gap - contact.wheel_skin) * (1 + 1e-12))
+    assert np.all(gap >= contact.skin * (1 - 1e-12))  # no less than the candidates' own margin
+    assert allowance.max() > 1.5 * SPHERE_SKINS * s.skin  # a thrown grain is not held to the margin
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_grain_in_the_air_or_above_the_grid_searches_further(seed):
+    """Two grains lifted clear of the bed, one of them above the grid's top (a thrown grain the grid clamps into its
+    top layer): their search widens to 7 cells a side, and their clearance is still a lower bound on every unlisted
+    gap (brute force), and at least three cells less the two radii unless a true gap is less."""
+    s = settled_box(seed)
+    state = s.state()
+    top = np.argsort(state["x"][:, 2])[-2:]
+    state["x"][top[0]] = (0.06, 0.07, 0.22)
+    state["x"][top[1]] = (0.09, 0.08, 0.36)  # above the domain (0.3 m) and the grid
+    state["v"][top] = (0.0, 0.0, 3.0)
+    state["hist_xi_wall"][top] = state["hist_roll_wall"][top] = 0.0
+    s.restore_state(state)
+    s.step(1)
+    nl = s.device.neighbor_list
+    assert nl.widened >= 2
+    clearance = nl.clearance.to_numpy()
+    sphere, wall = unlisted_gaps(s)
+    true = np.minimum(sphere, wall)
+    assert np.all(clearance <= true * (1 + 1e-12))
+    r, cell = s.radii, nl.grid.cell
+    assert np.all(clearance[top] >= np.minimum(true[top], 3 * cell - r[top] - r.max()) * (1 - 1e-12))
+    assert np.all(clearance[top] > 2 * cell)  # the walls, 60 mm off, bound them here, not the 27 cells (< 23 mm)
+
+
+def test_the_widened_clearance_stops_at_the_block_it_searched():
+    """A grain above a layer of spheres whose nearest one lies just beyond the 7 cells a side searched: its clearance
+    is the wide block's bound, below the true gap (brute force) and at least three cells less the two radii."""
+    rng = np.random.default_rng(5)
+    xy = np.stack(np.meshgrid(*[np.arange(0.05, 0.351, 0.025)] * 2, indexing="ij"), -1).reshape(-1, 2)
+    layer = np.c_[xy, np.full(len(xy), 0.011)]
+    r = rng.uniform(0.006, 0.0105, len(layer) + 1)
+    s = Scene((0, 0, 0), (0.4, 0.4, 0.4))
+    s.add_box_walls()
+    s.add_spheres(np.r_[layer, [[0.2, 0.2, 0.2]]], r)
+    s.time_step = 5e-5
+    s.step(1)
+    grid = s.device.neighbor_list.grid
+    origin_z, cell = grid.origin[2], grid.cell
+    below = int((0.011 - origin_z) // cell)
+    state = s.state()
+    state["x"][-1] = (0.2, 0.2, origin_z + (below + 4.5) * cell)  # four cells above the layer's, mid-cell
+    state["v"][-1] = (0.0, 0.0, 3.0)
+    s.restore_state(state)
+    s.step(1)
+    nl = s.device.neighbor_list
+    assert nl.widened >= 1
+    clearance = nl.clearance.to_numpy()
+    sphere, wall = unlisted_gaps(s)
+    true = min(sphere[-1], wall[-1])
+    assert clearance[-1] <= true * (1 + 1e-12)
+    assert clearance[-1] >= 3 * cell - r[-1] - r.max()
+    assert true < 5 * cell - r[-1] - r.max()  # what a bound two cells wider than the search would have claimed

@@ -103,11 +103,12 @@ def who_rebuilds(scene, bench, steps: int) -> None:
         speed = float(np.linalg.norm(scene.velocities[i]))
         hub = np.asarray(bench.structure.hub_position)
         where = "far" if np.linalg.norm(scene.positions[i] - hub) > 1.5 * bench.wheel.radius else "near the wheel"
-        kind = "capped" if allowance[i] < 0.5 * clearance[i] * (1 - 1e-9) else "own"
+        # held: its allowance below half its clearance (the wheel's gap to it, or a cap); own: half its clearance
+        kind = "held by the wheel" if allowance[i] < 0.5 * clearance[i] * (1 - 1e-9) else "own"
         asked[f"{where}, {kind}"] = asked.get(f"{where}, {kind}", 0) + 1
         print(f"step {scene.steps_taken}: sphere {i} asked ({ratio[i]:.2f} of its allowance before the step), "
-              f"{speed:.3f} m/s, clearance {1e3 * clearance[i]:.3f} mm (skin {1e3 * nl.skin:.3f}), at "
-              f"{np.round(1e3 * scene.positions[i], 1)} mm, {where}", flush=True)
+              f"{speed:.3f} m/s, allowance {1e3 * allowance[i]:.3f} mm, clearance {1e3 * clearance[i]:.3f} mm (skin "
+              f"{1e3 * nl.skin:.3f}), at {np.round(1e3 * scene.positions[i], 1)} mm, {where}, {kind}", flush=True)
     print(f"who asked, over {steps} steps: {asked}", flush=True)
 
 
