@@ -32,5 +32,9 @@ start "wide-box calibration, then its choice's checks (issue 33)" \
     --out docs/soillab/calibration-epsd-box --resume --cache "$1/lab-cache" \
     && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
   "$PY" "$RUNS"
-start "five-gravity campaigns (issue 36)" "validation/campaigns/five-gravities.sh|validation_campaign.py" \
-  "$RUNS/five-gravities.out" bash docs/validation/campaigns/five-gravities.sh
+# The five-gravity campaigns finished on 2026-11-29 and the rule was accepted (campaigns.md); the validation examples'
+# leave-one-angle-out runs under it resume here (their finished folds are kept; the other examples were run again
+# whole on that day: docs/validation/examples-five-gravities.log).
+start "validation examples' cross-validations under the accepted rule (issue 36)" "validation_examples.py" \
+  docs/validation/examples-five-gravities.log \
+  "$PY" docs/validation_examples.py --only cmu-cv-steering-both cmu-cv-steering-smooth cmu-cv-steering-grouser
