@@ -27,6 +27,10 @@ def _timed(obj, name: str, totals: dict, key: str) -> None:
     setattr(obj, name, wrapper)
 
 
+#: The wheel candidates' margin for the spheres' motion, in skins, before the widened search (2026-11-29): the
+#: ``narrow_too`` variant's (:func:`coupled_against_soil`).
+FORMER_SPHERE_SKINS = 2.0
+
 #: The coupled step's timed parts (wrapped methods of the wheel contact), each with its CPU time beside.
 _PARTS = ("wheel", "contact", "rebuild", "wheel_cpu", "contact_cpu", "rebuild_cpu")
 
@@ -70,7 +74,8 @@ def coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_s
     (:class:`~wheelsoil.granular.interaction.HalfSkinRule`; ``half_skin_*`` figures); ``sphere_skins``, with the wheel
     contact's margin for the spheres' motion (the least allowance it leaves a sphere near the wheel) at each of these
     many skins; ``narrow_too``, as before the widened clearance search and the wheel's per-sphere bound (the
-    27-cell clearance, every allowance capped at the candidates' margin: ``variants``)."""
+    27-cell clearance, every allowance capped at the candidates' margin of then, :data:`FORMER_SPHERE_SKINS`:
+    ``variants``)."""
     from wheelsoil.cases import build
     from wheelsoil.coupling.rig import soil_headroom
     from wheelsoil.granular.interaction import HalfSkinRule, SkinCap
@@ -94,16 +99,18 @@ def coupled_against_soil(bench, bed, case, steps: int, rounds: int, arch, half_s
     # the other settings: (name, set up, undo); each round steps every one of them, then today's, then the soil alone
     others = [("half skin", lambda: scene.interactions.append(rule), lambda: scene.interactions.remove(rule))] \
         if half_skin_too else []
-    if narrow_too:  # the allowance before the widened search and the wheel's per-sphere bound
-        narrow = SkinCap(default_skins)
+    if narrow_too:  # the allowance before the widened search and the wheel's per-sphere bound, at its margin then
+        narrow = SkinCap(FORMER_SPHERE_SKINS)
 
         def enter_narrow():
             scene.widen_steps = 0
             scene.interactions.append(narrow)
+            c.sphere_skins = FORMER_SPHERE_SKINS
 
         def leave_narrow():
             scene.widen_steps = WIDEN_HORIZON_STEPS
             scene.interactions.remove(narrow)
+            c.sphere_skins = default_skins
 
         others.append(("27 cells, uniform cap", enter_narrow, leave_narrow))
     for k in sphere_skins:

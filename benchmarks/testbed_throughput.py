@@ -282,7 +282,7 @@ def main(argv=None) -> int:
     ap.add_argument("--narrow-too", action="store_true",
                     help="with --cmu: each round also steps the testbed with the allowance as before the widened "
                          "clearance search and the wheel's per-sphere bound (27 cells, every allowance capped at the "
-                         "wheel candidates' margin), timed apart")
+                         "wheel candidates' margin of then, two skins), timed apart")
     ap.add_argument("--part", choices=("fe-seed004", "dem-seed004", "base", "smoke", "cmu"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.set and not args.cmu:

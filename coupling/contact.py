@@ -109,9 +109,10 @@ def _grown(arrays: dict, name: str, dtype, size: int, shape_tail: tuple = ()):
 
 #: The candidates' margin for the spheres' motion between two rebuilds, in the scene's skins: the least allowance the
 #: wheel leaves a sphere near it (a sphere clear of its neighbours may otherwise move up to half its clearance;
-#: :func:`wheelsoil.granular.neighbors.displacement_allowance`). Two skins: four times the plain Verlet half skin,
-#: for a margin 6/5 of the former one (skin + 4 skins of the wheel's own).
-SPHERE_SKINS = 2.0
+#: :func:`wheelsoil.granular.neighbors.displacement_allowance`). Four skins: a grain thrown up along the wheel's face
+#: lists the facets a few millimetres off it, so it is not held to a rebuild every few dozen steps; at the rig's
+#: scale 22 rebuilds in 1,200 steps against 43 at two skins, for the same contact cost (benchmarks/README.md).
+SPHERE_SKINS = 4.0
 #: How far beyond the candidates' reach, in grid cells, a sphere's cell is checked for facets at all
 #: (:func:`.candidate_kernels.mark_near_cells`): a sphere in a cell with none within that reach may move that much
 #: further before the scene rebuilds, so that the wheel does not hold back a grain it has thrown clear.
