@@ -9,6 +9,10 @@
 # already running is left alone. The twin and the calibration get one Taichi thread each (two runs on two cores step
 # 1.18-1.26 times faster in all than with a thread per core each); the campaigns, pure NumPy, at normal priority
 # (a draw is 10-30 s of CPU; at nice 10 beside two DEM runs it got an eighth of a core).
+# The jobs run the working tree's code: a Taichi kernel compiles at its first call, from its file as it is then, so
+# editing a module with kernels under a running job that has not yet called them stops it (a soil-lab wheel replica
+# died so on 2026-11-29, compiling the wheel contact's candidate kernels from the file changed under it). Edit kernel
+# modules while the jobs run only once they are past their first wheel contact, or restart them after.
 set -u
 cd "$(dirname "$0")/.."
 RUNS=${1:-/work/runs}
