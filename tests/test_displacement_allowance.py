@@ -53,9 +53,9 @@ def throw_top_grains(s: Scene, count: int, speed: float) -> np.ndarray:
     return top
 
 
-def unlisted_gaps(s: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """Brute force at the last rebuild: each sphere's least gap to a sphere listed with it by neither row, and to a
-    wall it does not list [m]."""
+def least_unlisted_gaps(s: Scene) -> np.ndarray:
+    """Brute force at the last rebuild: each sphere's least gap [m] to a sphere listed with it by neither row or to a
+    wall it does not list."""
     device = s.device
     nl = device.neighbor_list
     x = device.particles.x_ref.to_numpy()
@@ -73,7 +73,18 @@ def unlisted_gaps(s: Scene) -> tuple[np.ndarray, np.ndarray]:
     near = device.walls.near.to_numpy()
     not_near = (near[:, None] & (1 << np.arange(len(s.walls)))[None]) == 0
     wall = np.where(not_near, wall_gap, np.inf).min(axis=1)
-    return sphere, wall
+    return np.minimum(sphere, wall)
+
+
+def lift(s: Scene, index, positions, speed: float) -> None:
+    """Put spheres ``index`` at ``positions`` [m], rising at ``speed`` [m/s] with no wall contact remembered, and step
+    once (the restored state rebuilds the lists)."""
+    state = s.state()
+    state["x"][index] = positions
+    state["v"][index] = (0.0, 0.0, speed)
+    state["hist_xi_wall"][index] = state["hist_roll_wall"][index] = 0.0
+    s.restore_state(state)
+    s.step(1)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -83,8 +94,7 @@ def test_clearance_is_a_lower_bound_on_every_unlisted_gap_and_no_less_than_the_b
     s.step(300)
     nl = s.device.neighbor_list
     clearance = nl.clearance.to_numpy()
-    sphere, wall = unlisted_gaps(s)
-    true = np.minimum(sphere, wall)
+    true = least_unlisted_gaps(s)
     assert np.all(clearance <= true * (1 + 1e-12))  # never more than a true gap: the lists stay complete
     assert np.all(clearance >= nl.skin * (1 - 1e-12))  # every sphere is inside the grid here
     # beyond the 27 cells searched, the bound is at least one cell edge less the two radii
@@ -210,19 +220,12 @@ def test_a_grain_in_the_air_or_above_the_grid_searches_further(seed):
     top layer): their search widens to 7 cells a side, and their clearance is still a lower bound on every unlisted
     gap (brute force), and at least three cells less the two radii unless a true gap is less."""
     s = settled_box(seed)
-    state = s.state()
-    top = np.argsort(state["x"][:, 2])[-2:]
-    state["x"][top[0]] = (0.06, 0.07, 0.22)
-    state["x"][top[1]] = (0.09, 0.08, 0.36)  # above the domain (0.3 m) and the grid
-    state["v"][top] = (0.0, 0.0, 3.0)
-    state["hist_xi_wall"][top] = state["hist_roll_wall"][top] = 0.0
-    s.restore_state(state)
-    s.step(1)
+    top = np.argsort(s.positions[:, 2])[-2:]
+    lift(s, top, [(0.06, 0.07, 0.22), (0.09, 0.08, 0.36)], 3.0)  # the second above the domain (0.3 m) and the grid
     nl = s.device.neighbor_list
     assert nl.widened >= 2
     clearance = nl.clearance.to_numpy()
-    sphere, wall = unlisted_gaps(s)
-    true = np.minimum(sphere, wall)
+    true = least_unlisted_gaps(s)
     assert np.all(clearance <= true * (1 + 1e-12))
     r, cell = s.radii, nl.grid.cell
     assert np.all(clearance[top] >= np.minimum(true[top], 3 * cell - r[top] - r.max()) * (1 - 1e-12))
@@ -244,16 +247,11 @@ def test_the_widened_clearance_stops_at_the_block_it_searched():
     grid = s.device.neighbor_list.grid
     origin_z, cell = grid.origin[2], grid.cell
     below = int((0.011 - origin_z) // cell)
-    state = s.state()
-    state["x"][-1] = (0.2, 0.2, origin_z + (below + 4.5) * cell)  # four cells above the layer's, mid-cell
-    state["v"][-1] = (0.0, 0.0, 3.0)
-    s.restore_state(state)
-    s.step(1)
+    lift(s, [-1], [(0.2, 0.2, origin_z + (below + 4.5) * cell)], 3.0)  # four cells above the layer's, mid-cell
     nl = s.device.neighbor_list
     assert nl.widened >= 1
     clearance = nl.clearance.to_numpy()
-    sphere, wall = unlisted_gaps(s)
-    true = min(sphere[-1], wall[-1])
+    true = least_unlisted_gaps(s)[-1]
     assert clearance[-1] <= true * (1 + 1e-12)
     assert clearance[-1] >= 3 * cell - r[-1] - r.max()
     assert true < 5 * cell - r[-1] - r.max()  # what a bound two cells wider than the search would have claimed
