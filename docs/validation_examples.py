@@ -75,6 +75,7 @@ def main(argv=None) -> int:
     import os
 
     from wheelsoil.cases.cli import main as validate_cli
+    from wheelsoil.validation.crossval import carry_verdicts
 
     args = sys.argv[1:] if argv is None else argv
     tables_only = "--tables-only" in args
@@ -115,8 +116,9 @@ def main(argv=None) -> int:
     rows += ["", "## Leave one steering angle out", "",
              "Each steering angle of the CMU data held out in turn; the workflow runs on the other angles and predicts "
              "the held-out one (`--cv slip_angle`). Gains per held-out angle are in each `crossval.md`.", "",
-             "| example | data | found in how many folds | a residual trend left unexplained, folds | gain per "
-             "held-out angle |", "|---|---|---|---|---|"]
+             "| example | data | found in how many folds | carried to the angle held out (folds with a gain above "
+             "two bootstrap sd, of those with it in the model) | a residual trend left unexplained, folds | gain per "
+             "held-out angle |", "|---|---|---|---|---|---|"]
     for name, (data, what) in CV_EXAMPLES.items():
         out = ROOT / "validation" / name
         argv = ["validate", data, "--cv", "slip_angle", "--report", str(out.relative_to(ROOT.parent)), "--resume"]
@@ -131,7 +133,9 @@ def main(argv=None) -> int:
             found += "; partial (accepted, not named) " + "; ".join(partial)
         gains = ", ".join(f"{f['level']:g}°: {f['gain']:+.3f} ± {f['gain_std']:.3f}" for f in cv["folds"])
         unexplained = sum(1 for f in cv["folds"] if f["unexplained"])
-        rows.append(f"| [{name}]({name}/crossval.md) | {what} | {found} | {unexplained}/{n} | {gains} |")
+        carried = ", ".join(f"{v['mechanism']} {len(v['carried'])}/{len(v['carried']) + len(v['not_carried'])}"
+                            for v in carry_verdicts(cv)) or "–"
+        rows.append(f"| [{name}]({name}/crossval.md) | {what} | {found} | {carried} | {unexplained}/{n} | {gains} |")
     rows += ["", "## Periodic effects in time series", "",
              "| example | question | frequency law | amplitude mechanism | parameter (hidden) | held-out gain in log "
              "amplitude |", "|---|---|---|---|---|---|"]

@@ -2,6 +2,8 @@
 every level is found on the rest and gains on the held-out level; a fold's final model is the classical one
 unless something was accepted; the report lists found, partial and unexplained per fold."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -79,3 +81,33 @@ def test_the_rule_digest_follows_the_rivals_and_margins(monkeypatch):
     fewer = {k: v for k, v in terramechanics.DRIFT_MEASURES.items() if k != "signed_slip"}
     monkeypatch.setattr(selection, "DRIFT_MEASURES", fewer)
     assert selection.rule_digest() != before
+
+
+def _fold(level, gain, gain_std, found=(), partial=()):
+    return {"level": level, "rows": 27, "found": list(found), "partial": list(partial), "ambiguities": [],
+            "unexplained": [], "classical_nrmse": 1.0, "final_nrmse": 1.0 - gain, "gain": gain, "gain_std": gain_std}
+
+
+def test_a_finding_that_does_not_carry_to_a_held_out_level_is_reported_as_not_carrying(tmp_path):
+    """Per mechanism in any fold's final model: the levels where its fold's held-out gain exceeds two bootstrap
+    standard deviations (carried) and where it does not; named in fewer folds than there are, it is not a stable
+    finding. Hand-built folds, so every branch is met: one mechanism carried everywhere, one nowhere, one in part."""
+    cv = {"condition": "slip_angle", "selection_rule": "x", "found_in": {"a": 4, "c": 1},
+          "folds": [_fold(0.0, 0.30, 0.05, found=["a"], partial=["b"]),
+                    _fold(30.0, 0.10, 0.06, found=["a"], partial=["b"]),  # 0.10 < 2 x 0.06: not carried
+                    _fold(60.0, 0.21, 0.10, found=["a", "c"]),  # 0.21 > 2 x 0.10: carried
+                    _fold(90.0, 0.50, 0.02, found=["a"], partial=["c"])]}
+    from wheelsoil.validation.crossval import carry_verdicts
+
+    v = {x["mechanism"]: x for x in carry_verdicts(cv)}
+    assert v["a"]["carried"] == [0.0, 60.0, 90.0] and v["a"]["not_carried"] == [30.0]
+    assert v["a"]["verdict"] == "carries to some levels held out, not to others"
+    assert v["b"]["partial"] == [0.0, 30.0] and v["b"]["named"] == [] and v["b"]["not_carried"] == [30.0]
+    assert v["c"]["named"] == [60.0] and v["c"]["partial"] == [90.0] and v["c"]["not_carried"] == []
+    assert v["c"]["verdict"] == ("carries to every level held out where it is in the model; named in 1 of 4 folds "
+                                 "only: not a stable finding")
+    only_30 = {**cv, "folds": [f for f in cv["folds"] if f["level"] == 30.0]}
+    assert carry_verdicts(only_30)[0]["verdict"] == "does not carry: no held-out gain where it is in the model"
+    md = write_cross_validation(cv, SimpleNamespace(name="hand-built folds"), tmp_path).read_text()
+    assert "| a | 0, 30, 60, 90 | – | 0, 60, 90 | 30 | carries to some levels held out, not to others |" in md
+    assert "| c | 60 | 90 | 60, 90 | – |" in md

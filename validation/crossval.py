@@ -27,6 +27,10 @@ from .selection import rule_digest
 
 CV_CONDITIONS = ("slip", "slip_angle", "load", "gravity", "passes", "grouser_height", "group")
 
+#: A fold's held-out gain carries when it exceeds this many of its bootstrap standard deviations (about a one-sided
+#: 2.3 % chance of a gain that large from a final model no better than the classical one).
+CARRY_SIGMAS = 2.0
+
 
 def levels(data: Measurements, by: str) -> list:
     """The distinct levels of condition ``by`` in ``data`` (sorted)."""
@@ -110,6 +114,56 @@ def cross_validate(data: Measurements, by: str, *, responses, seed: int = 0, boo
             "selection_rule": rule}
 
 
+def carry_verdicts(cv: dict) -> list[dict]:
+    """Whether each mechanism carries to the levels held out: for every mechanism in any fold's final model (named, or
+    accepted as partial), the levels where it was named and where partial, the held-out gain of each of those folds,
+    the levels where that gain exceeds :data:`CARRY_SIGMAS` of its bootstrap standard deviation (``carried``) and
+    where it does not (``not_carried``), and a verdict. The gain is the fold's final model's, with every mechanism it
+    holds in that fold, so a mechanism is credited only with the gain of the models it is part of; named in fewer
+    folds than there are, it is also not a stable finding of the data, and the verdict says so."""
+    folds = cv["folds"]
+    names = sorted({n for f in folds for n in (*f["found"], *f.get("partial", ()))})
+    out = []
+    for name in names:
+        named = [f for f in folds if name in f["found"]]
+        partial = [f for f in folds if name in f.get("partial", ()) and name not in f["found"]]
+        in_model = [f for f in folds if name in f["found"] or name in f.get("partial", ())]
+        carried = [f["level"] for f in in_model if f["gain"] > CARRY_SIGMAS * f["gain_std"]]
+        not_carried = [f["level"] for f in in_model if f["level"] not in carried]
+        if not not_carried:
+            verdict = "carries to every level held out where it is in the model"
+        elif not carried:
+            verdict = "does not carry: no held-out gain where it is in the model"
+        else:
+            verdict = "carries to some levels held out, not to others"
+        if named and len(named) < len(folds):
+            verdict += f"; named in {len(named)} of {len(folds)} folds only: not a stable finding"
+        out.append({"mechanism": name, "named": [f["level"] for f in named], "partial": [f["level"] for f in partial],
+                    "gains": {str(f["level"]): (f["gain"], f["gain_std"]) for f in in_model},
+                    "carried": carried, "not_carried": not_carried, "verdict": verdict})
+    return out
+
+
+def _carry_lines(cv: dict, by: str) -> list[str]:
+    """The section of ``crossval.md`` that says whether each finding carries (:func:`carry_verdicts`)."""
+    verdicts = carry_verdicts(cv)
+    if not verdicts:
+        return []
+
+    def levels_text(values) -> str:
+        return ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in values) or "–"
+
+    lines = ["## Does each finding carry to the level held out?", "",
+             f"A fold's gain counts as carried above {CARRY_SIGMAS:g} of its bootstrap standard deviations; the gain "
+             "is the fold's final model's, with every mechanism it holds there.", "",
+             f"| mechanism | named, held-out {by} | partial, held-out {by} | carried to | not carried to | verdict |",
+             "|---|---|---|---|---|---|"]
+    for v in verdicts:
+        lines.append(f"| {v['mechanism']} | {levels_text(v['named'])} | {levels_text(v['partial'])} | "
+                     f"{levels_text(v['carried'])} | {levels_text(v['not_carried'])} | {v['verdict']} |")
+    return lines + [""]
+
+
 def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, command: str = "",
                            provenance_record: dict | None = None) -> Path:
     """``crossval.md`` and ``crossval.json`` in ``out``; ``provenance_record``: the run's own, when the files are
@@ -136,7 +190,9 @@ def write_cross_validation(cv: dict, data: Measurements, out: str | Path, *, com
     n = len(cv["folds"])
     lines += ["", "Found in how many folds: " + (", ".join(f"{k} {v} of {n}" for k, v in cv["found_in"].items())
                                                  or "nothing in any fold"), ""]
+    lines += _carry_lines(cv, by.replace("_", " "))
     md = out / "crossval.md"
     write_markdown_and_json(md, "\n".join(lines), out / "crossval.json", {
-        **cv, "command": command, "provenance": provenance_record or provenance()}, default=float)
+        **cv, "carry": carry_verdicts(cv), "command": command, "provenance": provenance_record or provenance()},
+        default=float)
     return md
