@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The long campaigns that run in the background across sessions (issues 33, 34, 36), each resumable: this script
+# The long campaigns that run in the background across sessions (issues 33, 34, 35), each resumable: this script
 # starts those not running, with the settings they share the machine's two cores under. Run it from the repository
 # root at the start of a session (a fresh machine keeps the repository, not RUNS):
 #   bash docs/background.sh [RUNS]        # RUNS: the runs folder outside the repository (default /work/runs)
@@ -36,9 +36,10 @@ start "wide-box calibration, then its choice's checks (issue 33)" \
     --out docs/soillab/calibration-epsd-box --resume --cache "$1/lab-cache" \
     && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
   "$PY" "$RUNS"
-# The five-gravity campaigns finished on 2026-11-29 and the rule was accepted (campaigns.md); the validation examples'
-# leave-one-angle-out runs under it resume here (their finished folds are kept; the other examples were run again
-# whole on that day: docs/validation/examples-five-gravities.log).
-start "validation examples' cross-validations under the accepted rule (issue 36)" "validation_examples.py" \
-  docs/validation/examples-five-gravities.log \
-  "$PY" docs/validation_examples.py --only cmu-cv-steering-both cmu-cv-steering-smooth cmu-cv-steering-grouser
+# The five-gravity campaigns and the validation examples' leave-one-angle-out runs under the accepted rule finished on
+# 2026-11-29 (docs/validation/campaigns.md, docs/validation/README.md); their core now runs issue 35's seed-001 sweep.
+# Seed 001's wheel and slips, flexible against rigid (issue 35 item 5; its comparison fixed before any run:
+# docs/sweeps/seed001-flexible-rigid/README.md): ten cases, hours each; finished cases are kept and a killed one
+# resumes from its checkpoint. When cases finish, copy RUNS/seed001-flexible-rigid/summary.csv into that folder.
+start "seed 001 flexible against rigid (issue 35)" "batch seed001-flexible-rigid" "$RUNS/seed001-flexible-rigid.log" \
+  "$PY" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$RUNS/seed001-flexible-rigid" --workers 1

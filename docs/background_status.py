@@ -1,11 +1,12 @@
-"""Where the long background campaigns stand (issues 33, 34, 36; ``docs/background.sh`` starts them): one screen.
+"""Where the long background campaigns stand (issues 33, 34, 35, 36; ``docs/background.sh`` starts them): one screen.
 
 * the CMU twin's queue (``docs/cmu-twin/queue.json``): its last start and end in ``RUNS/cmu_queue.log``, and for each
   case that has a checkpoint under ``RUNS/*/cases`` its simulated time and when it was written;
 * the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective,
   then the checks on its choice (``docs/soillab/choice-checks/run.sh``): the steps finished and the last log line;
 * the validation campaigns that ``docs/validation/campaigns/five-gravities.sh`` runs: the draws each has of its target;
-* the validation examples' cross-validations (``docs/validation_examples.py``): their folds under today's rule.
+* issue 35's sweeps (``SWEEPS``, under RUNS): their cases by status; a running case's checkpoint is listed with the
+  twin's.
 
 Reads files only (it starts and stops nothing), so it can run beside the jobs::
 
@@ -86,25 +87,23 @@ def campaign_lines() -> list[str]:
     return lines
 
 
-#: The validation examples' leave-one-angle-out runs that ``docs/background.sh`` resumes, and their log.
-CV_EXAMPLES = ("cmu-cv-steering-both", "cmu-cv-steering-smooth", "cmu-cv-steering-grouser")
-EXAMPLES_LOG = ROOT / "docs" / "validation" / "examples-five-gravities.log"
+#: Issue 35's sweeps that ``docs/background.sh`` runs, by their folder under RUNS.
+SWEEPS = ("seed001-flexible-rigid",)
 
 
-def example_lines() -> list[str]:
-    """Each cross-validation's folds saved under the rule in force (``validation.selection.rule_digest``), and the
-    examples log's last line."""
-    from wheelsoil.validation.selection import rule_digest
-
-    digest = rule_digest()
-    lines = ["validation examples' cross-validations (issue 36):"]
-    for name in CV_EXAMPLES:
-        folds = sorted((ROOT / "docs" / "validation" / name / "folds").glob("fold-*.json"))
-        current = sum(1 for f in folds if json.loads(f.read_text()).get("key", {}).get("rule") == digest)
-        lines.append(f"  {name}: {current} folds under today's rule ({len(folds)} saved)")
-    if EXAMPLES_LOG.is_file():
-        last = [ln for ln in EXAMPLES_LOG.read_text().splitlines() if ln.strip()]
-        lines.append(f"  log: {last[-1][:110] if last else '(empty)'}")
+def sweep_lines(runs: Path) -> list[str]:
+    """Each sweep's cases by status (its ``status.json``) and the cases it lists (``wheelsoil batch --list``'s count
+    is the sweep file's; here the ones it has started)."""
+    lines = ["issue 35's sweeps:"]
+    for name in SWEEPS:
+        status = runs / name / "status.json"
+        if not status.is_file():
+            lines.append(f"  {name}: not started (no {status})")
+            continue
+        counts: dict[str, int] = {}
+        for case in json.loads(status.read_text()).values():
+            counts[case["status"]] = counts.get(case["status"], 0) + 1
+        lines.append(f"  {name}: " + ", ".join(f"{n} {k}" for k, n in sorted(counts.items())))
     return lines
 
 
@@ -112,7 +111,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=Path, default=Path("/work/runs"), help="the runs folder (default /work/runs)")
     args = ap.parse_args(argv)
-    print("\n".join(twin_lines(args.runs) + calibration_lines() + campaign_lines() + example_lines()))
+    print("\n".join(twin_lines(args.runs) + calibration_lines() + campaign_lines() + sweep_lines(args.runs)))
 
 
 if __name__ == "__main__":
