@@ -385,23 +385,15 @@ def test_the_background_status_reads_the_queue_log_and_the_campaign_list(tmp_pat
     assert len(listed) == len(re.findall(r'"[\w-]+ \d+ \d+[^"]*"', script))  # every campaign of the script
 
 
-def test_the_background_status_counts_only_folds_saved_under_the_rule_in_force(tmp_path, monkeypatch):
-    """A cross-validation fold saved under another selection rule is computed again when the run resumes
-    (validation/crossval.py), so the status screen counts only the folds whose key holds today's rule."""
-    from wheelsoil.validation.selection import rule_digest
-
+def test_the_background_status_counts_a_sweeps_cases_by_status(tmp_path):
+    """Each of issue 35's sweeps: its cases by the status its ``status.json`` records, or not started without one."""
     status = _load("background_status")
-    monkeypatch.setattr(status, "ROOT", tmp_path)
-    monkeypatch.setattr(status, "EXAMPLES_LOG", tmp_path / "examples.log")
-    folds = tmp_path / "docs" / "validation" / status.CV_EXAMPLES[0] / "folds"
-    folds.mkdir(parents=True)
-    for k, rule in enumerate((rule_digest(), "an-older-rule", rule_digest())):
-        (folds / f"fold-{k}.json").write_text(json.dumps({"key": {"rule": rule}, "fold": {}}))
-    (tmp_path / "examples.log").write_text("wheelsoil validate a\n  held out slip_angle = 0.0: found nothing\n")
-    lines = status.example_lines()
-    assert lines[1] == f"  {status.CV_EXAMPLES[0]}: 2 folds under today's rule (3 saved)"
-    assert lines[2] == f"  {status.CV_EXAMPLES[1]}: 0 folds under today's rule (0 saved)"
-    assert lines[-1] == "  log:   held out slip_angle = 0.0: found nothing"
+    sweep = tmp_path / status.SWEEPS[0]
+    sweep.mkdir()
+    (sweep / "status.json").write_text(json.dumps({"a": {"status": "finished"}, "b": {"status": "failed"},
+                                                   "c": {"status": "finished"}}))
+    assert status.sweep_lines(tmp_path)[1] == f"  {status.SWEEPS[0]}: 1 failed, 2 finished"
+    assert status.sweep_lines(tmp_path / "elsewhere")[1].startswith(f"  {status.SWEEPS[0]}: not started")
 
 
 def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monkeypatch, measured_dir):
