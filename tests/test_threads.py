@@ -13,9 +13,13 @@ CHILD = (
     "import json, os\n"
     "from wheelsoil import runtime, threads\n"
     "runtime.init('cpu')\n"
-    "tasks = sorted(int(t) for t in os.listdir('/proc/self/task'))\n"
-    "print(json.dumps({'pinned': {str(t): c for t, c in threads.pinned_threads().items()},\n"
-    "                  'affinity': {str(t): sorted(os.sched_getaffinity(t)) for t in tasks}}))\n"
+    "affinity = {}\n"
+    "for t in sorted(int(t) for t in os.listdir('/proc/self/task')):\n"
+    "    try:\n"
+    "        affinity[str(t)] = sorted(os.sched_getaffinity(t))\n"
+    "    except ProcessLookupError:\n"
+    "        pass  # a short-lived thread that ended between the listing and the query\n"
+    "print(json.dumps({'pinned': {str(t): c for t, c in threads.pinned_threads().items()}, 'affinity': affinity}))\n"
 )
 
 
