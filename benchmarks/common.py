@@ -135,3 +135,23 @@ def compile_time_cold() -> dict:
         "print(t1-t0, t2-t1, t3-t2)"
     )
     return cache_times(code, ("init_s", "first_step_s", "steady_step_s"))
+
+
+def alternating_kernel_times(calls: dict, rounds: int, repeats: int = 5) -> dict:
+    """Seconds per call of each of ``calls`` ({name: function with no arguments that launches Taichi kernels}), timed
+    in ``rounds`` rounds of ``repeats`` calls each, the order reversed every other round and the device synchronised
+    around each timing (a shared machine's drift then falls on every function alike); {name: array of one time per
+    round}."""
+    import taichi as ti
+
+    times: dict = {name: [] for name in calls}
+    order = list(calls.items())
+    for k in range(rounds):
+        for name, call in order if k % 2 == 0 else order[::-1]:
+            ti.sync()
+            t0 = time.perf_counter()
+            for _ in range(repeats):
+                call()
+            ti.sync()
+            times[name].append((time.perf_counter() - t0) / repeats)
+    return {name: np.array(t) for name, t in times.items()}

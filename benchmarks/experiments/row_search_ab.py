@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import time
 
 import numpy as np
 
@@ -31,8 +30,7 @@ def main(argv=None) -> int:
     from wheelsoil import runtime
 
     runtime.init("cpu")
-    import taichi as ti
-
+    from wheelsoil.benchmarks.common import alternating_kernel_times
     from wheelsoil.cases import build
     from wheelsoil.cases.schema import load_case
     from wheelsoil.granular import neighbors, prepare_bed
@@ -55,17 +53,8 @@ def main(argv=None) -> int:
                                            g.period, g.inv_period, nl.nbr, nl.count)
 
     today(), earlier()  # compile
-    times: dict[str, list[float]] = {"before": [], "today": []}
-    for k in range(args.rounds):
-        order = (("before", earlier), ("today", today))
-        for name, kernel in order if k % 2 == 0 else order[::-1]:
-            ti.sync()
-            t0 = time.perf_counter()
-            for _ in range(5):
-                kernel()
-            ti.sync()
-            times[name].append((time.perf_counter() - t0) / 5)
-    b, t = np.array(times["before"]), np.array(times["today"])
+    times = alternating_kernel_times({"before": earlier, "today": today}, args.rounds)
+    b, t = times["before"], times["today"]
     print(f"{scene.n_particles} spheres, row search: before {1e3 * b.min():.1f} ms best / {1e3 * np.median(b):.1f} "
           f"median, today {1e3 * t.min():.1f} / {1e3 * np.median(t):.1f}; today / before {t.min() / b.min():.2f} best, "
           f"{np.median(t / b):.2f} median of rounds")

@@ -4,14 +4,14 @@ Today's ``granular/neighbors.py: build_neighbor_lists`` loops over the spheres i
 candidate's position and radius through ``sorted_ids`` (scattered reads). The variant here first gathers (x, r) into
 ``cell_xr`` in the cells' order (one pass), then loops over the slots in that order, so that a sphere's 27 cells are
 read as runs of contiguous memory and neighbouring threads work on neighbouring cells. It fills the same rows and
-clearances to the bit (checked here before the timing). The CMU twin's bed (``cmu-grouser`` with the settings given)
+clearances to the bit (checked here before the timing). The variant kernel is a copy of today's with only its reads changed: the copy is the
+point of an A/B. The CMU twin's bed (``cmu-grouser`` with the settings given)
 after 20 steps; eight rounds of five calls each, alternating, best and median per call (benchmarks/README.md, issue
 37, 2026-11-29 evening)::
 
     python benchmarks/experiments/row_search_cell_order.py soil.diameter_min=0.003072 soil.diameter_max=0.004608
 """
 import sys
-import time
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from wheelsoil import runtime
 runtime.init("cpu")
 import taichi as ti  # noqa: E402
 
+from wheelsoil.benchmarks.common import alternating_kernel_times  # noqa: E402
 from wheelsoil.cases import build  # noqa: E402
 from wheelsoil.cases.schema import load_case  # noqa: E402
 from wheelsoil.granular import neighbors, prepare_bed  # noqa: E402
@@ -105,17 +106,8 @@ def main() -> None:
     cell_order()
     same = all(np.array_equal(a, b) for a, b in zip(ref, lists()))
     print(f"the same rows, counts and clearances to the bit: {same and most[0] == most[1]}")
-    times: dict[str, list[float]] = {"today": [], "cell order": []}
-    for k in range(8):
-        order = (("today", today), ("cell order", cell_order))
-        for name, kernel in order if k % 2 == 0 else order[::-1]:
-            ti.sync()
-            t0 = time.perf_counter()
-            for _ in range(5):
-                kernel()
-            ti.sync()
-            times[name].append((time.perf_counter() - t0) / 5)
-    t, c = np.array(times["today"]), np.array(times["cell order"])
+    times = alternating_kernel_times({"today": today, "cell order": cell_order}, 8)
+    t, c = times["today"], times["cell order"]
     print(f"{scene.n_particles} spheres, row search: today {1e3 * t.min():.1f} ms best / {1e3 * np.median(t):.1f} "
           f"median, cell order (gather included) {1e3 * c.min():.1f} / {1e3 * np.median(c):.1f}; cell order / today "
           f"{c.min() / t.min():.2f} best, {np.median(c / t):.2f} median of rounds")
