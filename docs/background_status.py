@@ -92,8 +92,8 @@ SWEEPS = ("seed001-flexible-rigid",)
 
 
 def sweep_lines(runs: Path) -> list[str]:
-    """Each sweep's cases by status (its ``status.json``) and the cases it lists (``wheelsoil batch --list``'s count
-    is the sweep file's; here the ones it has started)."""
+    """Each sweep's cases by status, as its ``status.json`` records them (the cases the sweep has started; ``wheelsoil
+    batch SWEEP --list`` lists all of them)."""
     lines = ["issue 35's sweeps:"]
     for name in SWEEPS:
         status = runs / name / "status.json"
