@@ -37,9 +37,13 @@ start "wide-box calibration, then its choice's checks (issue 33)" \
     && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
   "$PY" "$RUNS"
 # The five-gravity campaigns and the validation examples' leave-one-angle-out runs under the accepted rule finished on
-# 2026-11-29 (docs/validation/campaigns.md, docs/validation/README.md); their core now runs issue 35's seed-001 sweep.
-# Seed 001's wheel and slips, flexible against rigid (issue 35 item 5; its comparison fixed before any run:
-# docs/sweeps/seed001-flexible-rigid/README.md): ten cases, hours each; finished cases are kept and a killed one
-# resumes from its checkpoint. When cases finish, copy RUNS/seed001-flexible-rigid/summary.csv into that folder.
-start "seed 001 flexible against rigid (issue 35)" "batch seed001-flexible-rigid" "$RUNS/seed001-flexible-rigid.log" \
-  "$PY" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$RUNS/seed001-flexible-rigid" --workers 1
+# 2026-11-29 (docs/validation/campaigns.md, docs/validation/README.md); their core now runs issue 35's sweeps, each
+# with its comparison fixed before any run: seed 004's own conditions at smoke scale (54 cases of 4-10 min;
+# docs/sweeps/seed004-like/README.md), then seed 001's wheel and slips, flexible against rigid (10 cases, hours each;
+# docs/sweeps/seed001-flexible-rigid/README.md). Finished cases are kept and a killed one resumes from its checkpoint;
+# when cases finish, their tables are written into those folders (the commands are in their READMEs).
+start "issue 35's sweeps: seed004-like, then seed001-flexible-rigid" \
+  "batch seed004-like|batch seed001-flexible-rigid" "$RUNS/issue35-sweeps.log" \
+  bash -c '"$0" -m wheelsoil.cases.cli batch seed004-like --out "$1/seed004-like" --workers 1; \
+    "$0" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$1/seed001-flexible-rigid" --workers 1' \
+  "$PY" "$RUNS"

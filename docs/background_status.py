@@ -88,7 +88,7 @@ def campaign_lines() -> list[str]:
 
 
 #: Issue 35's sweeps that ``docs/background.sh`` runs, by their folder under RUNS.
-SWEEPS = ("seed001-flexible-rigid",)
+SWEEPS = ("seed004-like", "seed001-flexible-rigid")
 
 
 def sweep_lines(runs: Path) -> list[str]:
