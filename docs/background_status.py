@@ -92,18 +92,16 @@ SWEEPS = ("seed004-like", "seed001-flexible-rigid")
 
 
 def sweep_lines(runs: Path) -> list[str]:
-    """Each sweep's cases by status, as its ``status.json`` records them (the cases the sweep has started; ``wheelsoil
-    batch SWEEP --list`` lists all of them)."""
+    """Each sweep's cases under ``RUNS/SWEEP/cases``: those with a ``summary.json`` (finished) and those started
+    without one (running, or stopped to resume; ``wheelsoil batch SWEEP --list`` names them all)."""
     lines = ["issue 35's sweeps:"]
     for name in SWEEPS:
-        status = runs / name / "status.json"
-        if not status.is_file():
-            lines.append(f"  {name}: not started (no {status})")
+        folders = sorted(p for p in (runs / name / "cases").glob("*") if p.is_dir())
+        if not folders:
+            lines.append(f"  {name}: no case started")
             continue
-        counts: dict[str, int] = {}
-        for case in json.loads(status.read_text()).values():
-            counts[case["status"]] = counts.get(case["status"], 0) + 1
-        lines.append(f"  {name}: " + ", ".join(f"{n} {k}" for k, n in sorted(counts.items())))
+        finished = sum(1 for p in folders if (p / "summary.json").is_file())
+        lines.append(f"  {name}: {finished} finished, {len(folders) - finished} started without a summary")
     return lines
 
 

@@ -385,15 +385,17 @@ def test_the_background_status_reads_the_queue_log_and_the_campaign_list(tmp_pat
     assert len(listed) == len(re.findall(r'"[\w-]+ \d+ \d+[^"]*"', script))  # every campaign of the script
 
 
-def test_the_background_status_counts_a_sweeps_cases_by_status(tmp_path):
-    """Each of issue 35's sweeps: its cases by the status its ``status.json`` records, or not started without one."""
+def test_the_background_status_counts_a_sweeps_cases(tmp_path):
+    """Each of issue 35's sweeps: its case folders with a summary (finished) and without one, or none started."""
     status = _load("background_status")
-    sweep = tmp_path / status.SWEEPS[0]
-    sweep.mkdir()
-    (sweep / "status.json").write_text(json.dumps({"a": {"status": "finished"}, "b": {"status": "failed"},
-                                                   "c": {"status": "finished"}}))
-    assert status.sweep_lines(tmp_path)[1] == f"  {status.SWEEPS[0]}: 1 failed, 2 finished"
-    assert status.sweep_lines(tmp_path / "elsewhere")[1].startswith(f"  {status.SWEEPS[0]}: not started")
+    cases = tmp_path / status.SWEEPS[0] / "cases"
+    for k, done in enumerate((True, False, True)):
+        (cases / f"case{k}").mkdir(parents=True)
+        if done:
+            (cases / f"case{k}" / "summary.json").write_text("{}")
+    lines = status.sweep_lines(tmp_path)
+    assert lines[1] == f"  {status.SWEEPS[0]}: 2 finished, 1 started without a summary"
+    assert lines[2] == f"  {status.SWEEPS[1]}: no case started"
 
 
 def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monkeypatch, measured_dir):
