@@ -35,6 +35,9 @@ from wheelsoil.taichi_types import (  # noqa: F401  (re-exported to forces.py, i
 
 from .grid import cell_coords, cell_index
 
+#: Six integers: the three runs of columns of a block row (:func:`column_runs`).
+ivec6 = ti.types.vector(6, ti.i32)
+
 
 @ti.func
 def nearest_image(d: vec3, period: ti.f64, inv_period: ti.f64) -> vec3:
@@ -45,16 +48,33 @@ def nearest_image(d: vec3, period: ti.f64, inv_period: ti.f64) -> vec3:
 
 
 @ti.func
-def block_cell(cc: ivec3, dims: ivec3, period: ti.f64) -> ti.i32:
-    """Flat index of cell ``cc`` of a searched block, wrapped around along a periodic x (``period`` > 0); -1 where
-    the cell lies beyond the grid."""
-    k = cc
+def column_runs(cx: ti.i32, cells: ti.i32, nx: ti.i32, period: ti.f64) -> ivec6:
+    """The columns cx - ``cells`` .. cx + ``cells`` of a row of ``nx`` cells along x, as three runs of consecutive
+    columns (first, last) side by side, each empty when its first exceeds its last: those within the grid, and along a
+    periodic x (``period`` > 0) those that wrap around from the row's far end and from its near end, each column once.
+    The cells of a row are consecutive in the flat index (:func:`.grid.cell_index`, x fastest), and so are their
+    spheres in the cell-sorted order, so a block's row is read as at most three runs of slots (:func:`row_slots`)
+    instead of cell by cell (the two integer remainders of a wrapped cell index took half the row search's time)."""
+    lo = ti.max(cx - cells, 0)
+    hi = ti.min(cx + cells, nx - 1)
+    a1, b1, a2, b2 = 0, -1, 0, -1
     if period > 0.0:
-        k[0] = ((cc[0] % dims[0]) + dims[0]) % dims[0]
-    cid = -1
-    if (k >= 0).all() and (k < dims).all():
-        cid = cell_index(k, dims)
-    return cid
+        if cx - cells < 0:
+            a1, b1 = ti.max(nx + cx - cells, hi + 1), nx - 1
+        if cx + cells > nx - 1:
+            a2, b2 = 0, ti.min(cx + cells - nx, lo - 1)
+    return ivec6(lo, hi, a1, b1, a2, b2)
+
+
+@ti.func
+def row_slots(cy: ti.i32, cz: ti.i32, first: ti.i32, last: ti.i32, dims: ivec3, cell_start: ti.template()):
+    """The slots [s0, s1) of the spheres in columns ``first`` .. ``last`` of the row (cy, cz): an empty range where
+    first > last or the row lies beyond the grid."""
+    s0, s1 = 0, 0
+    if first <= last and cy >= 0 and cy < dims[1] and cz >= 0 and cz < dims[2]:
+        base = cell_index(ivec3(0, cy, cz), dims)
+        s0, s1 = cell_start[base + first], cell_start[base + last + 1]
+    return s0, s1
 
 
 #: Where no face of a searched block bounds a sphere's clearance (the block holds every cell) [m].
@@ -168,10 +188,11 @@ def build_neighbor_lists(
         c = cell_coords(xi, origin, inv_cell, dims)
         clear = block_bound(xi, c, 1, origin, inv_cell, dims, period, ri + r_max)
         count = 0
-        for dz, dy, dx in ti.ndrange((-1, 2), (-1, 2), (-1, 2)):
-            cid = block_cell(c + ivec3(dx, dy, dz), dims, period)
-            if cid >= 0:
-                for s in range(cell_start[cid], cell_start[cid + 1]):
+        runs = column_runs(c[0], 1, dims[0], period)
+        for dz, dy in ti.ndrange((-1, 2), (-1, 2)):
+            for run in ti.static(range(3)):  # each block row as runs of consecutive cells
+                s0, s1 = row_slots(c[1] + dy, c[2] + dz, runs[2 * run], runs[2 * run + 1], dims, cell_start)
+                for s in range(s0, s1):
                     j = sorted_ids[s]
                     if j != i:
                         touch = ri + radius[j]
@@ -231,11 +252,11 @@ def widen_clearance(
             v[i].norm() * horizon > 0.5 * ti.max(skin, clear)
         ):
             wide = block_bound(xi, c, WIDE_CELLS, origin, inv_cell, dims, period, ri + r_max)
-            for dz, dy, dx in ti.ndrange((-WIDE_CELLS, WIDE_CELLS + 1), (-WIDE_CELLS, WIDE_CELLS + 1),
-                                         (-WIDE_CELLS, WIDE_CELLS + 1)):
-                cid = block_cell(c + ivec3(dx, dy, dz), dims, period)
-                if cid >= 0:
-                    for s in range(cell_start[cid], cell_start[cid + 1]):
+            runs = column_runs(c[0], WIDE_CELLS, dims[0], period)
+            for dz, dy in ti.ndrange((-WIDE_CELLS, WIDE_CELLS + 1), (-WIDE_CELLS, WIDE_CELLS + 1)):
+                for run in ti.static(range(3)):
+                    s0, s1 = row_slots(c[1] + dy, c[2] + dz, runs[2 * run], runs[2 * run + 1], dims, cell_start)
+                    for s in range(s0, s1):
                         j = sorted_ids[s]
                         if j != i:
                             touch = ri + radius[j]

@@ -4,8 +4,10 @@ Today's ``granular/neighbors.py: build_neighbor_lists`` loops over the spheres i
 candidate's position and radius through ``sorted_ids`` (scattered reads). The variant here first gathers (x, r) into
 ``cell_xr`` in the cells' order (one pass), then loops over the slots in that order, so that a sphere's 27 cells are
 read as runs of contiguous memory and neighbouring threads work on neighbouring cells. It fills the same rows and
-clearances to the bit (checked here before the timing). The variant kernel is a copy of today's with only its reads changed: the copy is the
-point of an A/B. The CMU twin's bed (``cmu-grouser`` with the settings given)
+clearances to the bit (checked here before the timing). The variant kernel is a copy of the row search of then with only its reads changed
+(the copy is the point of an A/B); it looks its cells up one by one, as that kernel did, so since the row search reads
+each block row as runs of columns (``neighbors.column_runs``, the same evening) "today" here is the faster kernel
+and the variant is compared with it on other terms than it was measured on. The CMU twin's bed (``cmu-grouser`` with the settings given)
 after 20 steps; eight rounds of five calls each, alternating, best and median per call (benchmarks/README.md, issue
 37, 2026-11-29 evening)::
 
@@ -24,10 +26,23 @@ from wheelsoil.benchmarks.common import alternating_kernel_times  # noqa: E402
 from wheelsoil.cases import build  # noqa: E402
 from wheelsoil.cases.schema import load_case  # noqa: E402
 from wheelsoil.granular import neighbors, prepare_bed  # noqa: E402
-from wheelsoil.granular.grid import cell_coords  # noqa: E402
+from wheelsoil.granular.grid import cell_coords, cell_index  # noqa: E402
 from wheelsoil.granular.neighbors import (  # noqa: E402
-    block_bound, block_cell, ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec4, nearest_image, sort_row, vec3, vec4,
+    block_bound, ivec3, nd_f64, nd_i32, nd_i32_2d, nd_vec3, nd_vec4, nearest_image, sort_row, vec3, vec4,
 )
+
+
+@ti.func
+def block_cell(cc: ivec3, dims: ivec3, period: ti.f64) -> ti.i32:
+    """Flat index of cell ``cc`` of a searched block, wrapped around along a periodic x; -1 beyond the grid (the
+    row search's cell lookup until the column runs of 2026-11-29, ``neighbors.column_runs``)."""
+    k = cc
+    if period > 0.0:
+        k[0] = ((cc[0] % dims[0]) + dims[0]) % dims[0]
+    cid = -1
+    if (k >= 0).all() and (k < dims).all():
+        cid = cell_index(k, dims)
+    return cid
 
 
 @ti.kernel
