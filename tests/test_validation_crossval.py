@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from wheelsoil.validation.crossval import cross_validate, write_cross_validation
+from wheelsoil.validation.crossval import carry_verdicts, cross_validate, write_cross_validation
 from wheelsoil.validation.discovery import RESPONSES
 from wheelsoil.validation.synthetic import conditions, draw_hidden_effect, synthetic_measurements
 
@@ -30,7 +30,10 @@ def test_a_hidden_mechanism_carries_to_every_held_out_steering_angle(seed, tmp_p
             assert f["final_nrmse"] == f["classical_nrmse"]
     md = write_cross_validation(cv, data, tmp_path, command="wheelsoil validate synthetic --cv slip_angle").read_text()
     assert "| held-out slip_angle | rows | found on the rest | unexplained on the rest |" in md
-    assert md.count("\n| ") == 1 + len(folds)  # header and one row per fold (the separator starts with "|-")
+    folds_table, _, carry_table = md.partition("## Does each finding carry to the level held out?")
+    assert folds_table.count("\n| ") == 1 + len(folds)  # header and one row per fold (the separator starts with "|-")
+    carried = [v for v in carry_verdicts(cv) if v["mechanism"] == "slip_sinkage"]
+    assert carried and carried[0]["not_carried"] == [] and "| slip_sinkage |" in carry_table
 
 
 def test_a_cross_validation_resumes_from_its_finished_folds(tmp_path, monkeypatch):
@@ -97,8 +100,6 @@ def test_a_finding_that_does_not_carry_to_a_held_out_level_is_reported_as_not_ca
                     _fold(30.0, 0.10, 0.06, found=["a"], partial=["b"]),  # 0.10 < 2 x 0.06: not carried
                     _fold(60.0, 0.21, 0.10, found=["a", "c"]),  # 0.21 > 2 x 0.10: carried
                     _fold(90.0, 0.50, 0.02, found=["a"], partial=["c"])]}
-    from wheelsoil.validation.crossval import carry_verdicts
-
     v = {x["mechanism"]: x for x in carry_verdicts(cv)}
     assert v["a"]["carried"] == [0.0, 60.0, 90.0] and v["a"]["not_carried"] == [30.0]
     assert v["a"]["verdict"] == "carries to some levels held out, not to others"
