@@ -5,8 +5,8 @@
 * the wide-box calibration (``docs/soillab/calibration-epsd-box``): its finished candidates and the least objective,
   then the checks on its choice (``docs/soillab/choice-checks/run.sh``): the steps finished and the last log line;
 * the validation campaigns that ``docs/validation/campaigns/five-gravities.sh`` runs: the draws each has of its target;
-* issue 35's sweeps (``SWEEPS``, under RUNS): their cases by status; a running case's checkpoint is listed with the
-  twin's.
+* issue 35's sweeps (``SWEEPS``, under RUNS): their cases finished and started; a running case's checkpoint is
+  listed with the twin's.
 
 Reads files only (it starts and stops nothing), so it can run beside the jobs::
 

@@ -16,6 +16,8 @@ import pytest
 from wheelsoil.granular import Scene
 from wheelsoil.granular.interaction import HalfSkinRule
 
+from lifted_grains import lift
+
 
 def _box(seed: int) -> Scene:
     rng = np.random.default_rng(seed)
@@ -74,17 +76,6 @@ def least_unlisted_gaps(s: Scene) -> np.ndarray:
     not_near = (near[:, None] & (1 << np.arange(len(s.walls)))[None]) == 0
     wall = np.where(not_near, wall_gap, np.inf).min(axis=1)
     return np.minimum(sphere, wall)
-
-
-def lift(s: Scene, index, positions, speed: float) -> None:
-    """Put spheres ``index`` at ``positions`` [m], rising at ``speed`` [m/s] with no wall contact remembered, and step
-    once (the restored state rebuilds the lists)."""
-    state = s.state()
-    state["x"][index] = positions
-    state["v"][index] = (0.0, 0.0, speed)
-    state["hist_xi_wall"][index] = state["hist_roll_wall"][index] = 0.0
-    s.restore_state(state)
-    s.step(1)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

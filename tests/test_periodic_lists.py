@@ -9,6 +9,8 @@ import pytest
 
 from wheelsoil.granular import Scene
 
+from lifted_grains import lift
+
 
 def _periodic_box(period: float, seed: int) -> Scene:
     """Spheres of 6-10.5 mm in a box periodic along x (length ``period`` [m]), 0.15 m wide, stirred at 0.5 m/s and
@@ -65,12 +67,7 @@ def test_a_grain_in_the_air_at_the_boundary_searches_around_it(period):
     holds at 0.07 m) is a lower bound on its nearest-image gap to every sphere it does not list."""
     s = _periodic_box(period, 3)
     top = int(np.argmax(s.positions[:, 2]))
-    state = s.state()
-    state["x"][top] = (0.001, 0.075, 0.2)
-    state["v"][top] = (0.0, 0.0, 3.0)
-    state["hist_xi_wall"][top] = state["hist_roll_wall"][top] = 0.0
-    s.restore_state(state)
-    s.step(1)
+    lift(s, [top], [(0.001, 0.075, 0.2)], 3.0)
     nl = s.device.neighbor_list
     assert nl.widened >= 1
     gap = _nearest_image_gaps(s)
