@@ -77,7 +77,7 @@ def testbed_spec(case: CaseFile) -> TestbedSpec:
         angular_velocity=t.angular_velocity,
         lowering_speed=t.lowering_speed, settle_time=t.settle_time, spin_up_time=t.spin_up_time,
         drive_time=t.drive_time, stop_when_steady=t.stop_when_steady, average_time=o.average_time,
-        windup=t.windup, windup_gain=t.windup_gain, max_wind_up=t.max_wind_up,
+        windup=t.windup, windup_gain=t.windup_gain, windup_filter=t.windup_filter, max_wind_up=t.max_wind_up,
         sample_interval=o.sample_interval, steady_tolerance=o.steady_tolerance, slip_tolerance=o.slip_tolerance,
         steady_checks=o.steady_checks, steady_drift_confidence=o.steady_drift_confidence, start_x=t.start_x, time_step=case.soil.time_step, rigid=case.wheel.rigid,
         damping=case.wheel.damping, axle_damping=t.axle_damping,

@@ -214,6 +214,8 @@ class Test(_Section):
                                           "holds omega; 'none': hold omega from the spin-up on")
     windup_gain: float = _q(smoke.TEST["windup_gain"], "1", "feedback gain of the wind-up controller",
                             _TEST["windup_gain"])
+    windup_filter: float = _q(smoke.TEST["windup_filter"], "s", "time constant of the filter on the tread's measured "
+                              "spin in the wind-up controller", _TEST["windup_filter"])
     max_wind_up: float = _q(smoke.TEST["max_wind_up"], "rad", "stop the run when the tread lags the hub by more than "
                             "this", _TEST["max_wind_up"])
     start_x: Optional[float] = _q(None, "m", "initial hub position along the bin (default: radius + 0.1 m; the "
@@ -312,4 +314,6 @@ class CaseFile(BaseModel):
             data.pop("protocol")
         if data["wheel"]["side_walls"] is None:
             data["wheel"].pop("side_walls")
+        if data["test"]["windup_filter"] == smoke.TEST["windup_filter"]:
+            data["test"].pop("windup_filter")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -27,6 +27,9 @@ from .patch_geometry import PatchGeometry
 #: What the slip may be taken against (:class:`TestbedSpec` ``slip_speed``).
 SLIP_SPEEDS = ("heading", "travel")
 
+#: The default slide damper's decay time [s]: axle_damping = wheel mass / AXLE_DAMPING_TIME (a free heave decays in it).
+AXLE_DAMPING_TIME = 0.1
+
 
 def _check(key: str, value, ok: bool, allowed: str) -> None:
     if not ok:

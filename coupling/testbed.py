@@ -75,8 +75,8 @@ from .patch import MovingPatch
 from .placement import wheel_start_centre
 from .protocol import advance, protocol_for, running_step
 from .protocol_state import ProtocolState
-from .rig import (RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig, soil_headroom,
-                  stage_spec, statistics_pitch)
+from .rig import (AXLE_DAMPING_TIME, RigPlan, TestbedSpec, batch_rate, batches_per_period, carriage_speed, plan_rig,
+                  soil_headroom, stage_spec, statistics_pitch)
 from .run_progress import RunProgress
 from .run_statistics import detect_from_rows
 from .run_summary import SERIES_UNITS
@@ -136,7 +136,7 @@ class Testbed:
         self.structure = Structure(mesh, hub_nodes=hub_nodes, hub_center=center, hub_mass=wheel.hub_mass,
                                    rigid=spec.rigid, damping=spec.damping, gravity=bs.gravity, arch=arch)
         self.wheel_mass = float(self.structure.mass.sum() + wheel.hub_mass)
-        self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / 0.1
+        self.axle_damping = spec.axle_damping if spec.axle_damping is not None else self.wheel_mass / AXLE_DAMPING_TIME
         self._slide_damper = 0.0  # the damper's force in the sample being taken [N]
         #: the wheel's weight [N] (3-vector), as its integrator applies it (the force balance's G)
         self.weight = self.structure.gravity_force()

@@ -191,6 +191,11 @@ def _grid_count(fractions: list[float], start: int, period: float = 1.0) -> int:
     raise WheelsoilInputError(f"no grid of up to 100000 divisions puts nodes at {fractions}")
 
 
+def wheel_mass(geometry: WheelGeometry) -> float:
+    """The wheel's whole mass [kg]: its mesh's lumped mass plus the hub's own (what the testbed's rig carries)."""
+    return build_wheel_mesh(geometry)[0].total_mass + geometry.hub_mass
+
+
 def build_wheel_mesh(geometry: WheelGeometry) -> tuple[StructureMesh, np.ndarray]:
     """Mesh the wheel. Returns the mesh and the indices of the hub nodes (spokes' inner ends)."""
     g = geometry

@@ -132,6 +132,15 @@ def test_case_hash_ignores_the_name_and_follows_the_physics():
     assert load_case("mini-1g-steer", ["case.seed=1"]).case_hash() != a.case_hash()
 
 
+def test_the_windup_filter_reaches_the_rig_and_its_default_keeps_the_hash():
+    a = load_case("smoke-moon-steer")
+    assert load_case("smoke-moon-steer", ["test.windup_filter=0.04"]).case_hash() == a.case_hash()
+    slow = load_case("smoke-moon-steer", ["test.windup_filter=0.098"])
+    assert slow.case_hash() != a.case_hash()
+    assert build.testbed_spec(slow).windup_filter == 0.098
+    assert build.testbed_spec(a).windup_filter == 0.04
+
+
 def test_the_rolling_law_reaches_every_soil_contact_and_the_default_keeps_the_hash():
     a = load_case("mini-1g-steer")
     assert load_case("mini-1g-steer", ["soil.rolling_model='cdt'"]).case_hash() == a.case_hash()

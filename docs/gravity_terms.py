@@ -1,0 +1,228 @@
+"""Why the traction coefficient moves at 1/6 g at equal mass, term by term (issue 35 item 4; docs/gravity-terms).
+
+The smoke case at 1g (W = 3000 N) and at 1/6 g (W = 500 N: the same mass) differ, once lengths and masses are kept,
+in three dimensionless groups besides gravity itself (wheelsoil.cases.similarity): the Froude number v^2 / (g r) (the
+rig's speeds are the same at both gravities), the grains' stiffness E / (rho g r) and the wheel's E I / (W r^2) (the
+same materials under a sixth of the load). The variants below are the 1g case carried to 1/6 g by the similarity
+transform with some of its scalings left out; each step from one to the next changes one group:
+
+    moon (the smoke-moon-steer replicas)  -- time scaled -->  froude  -- soil modulus / 6 -->  soil-stiffness
+        -- wheel modulus / 6 -->  similar (every group of the 1g case: must give the 1g case's coefficients)
+
+Commands (resumable; each run kept under RUNS/gravity-terms/<variant>/cases/<hash>):
+
+    python docs/gravity_terms.py run --runs RUNS --seeds 0 1        # seed 0 of every variant, then seed 1, ...
+    python docs/gravity_terms.py report --runs RUNS --out docs/gravity-terms
+
+The reading rule is fixed in docs/gravity-terms/README.md before any run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+BASE_CASE = "smoke-1g-steer"
+TARGET_GRAVITY = "moon"
+#: the baselines: the stored replica sets of the two smoke cases (docs/replicas.md)
+BASELINES = {"earth": ROOT / "docs/replicas/smoke-1g-steer/replicas.json",
+             "moon": ROOT / "docs/replicas/smoke-moon-steer/replicas.json"}
+#: the coefficients compared: quantity -> (name, divided by W, or by W r, or by r)
+COEFFICIENTS = {"drawbar_pull": ("DP / W", "W"), "lateral_force": ("F_y / W", "W"), "torque": ("T / (W r)", "Wr"),
+                "sinkage": ("z / r", "r")}
+WHEEL_RADIUS = 0.6  # m, the lunar-rover wheel's tread radius (seed 004)
+#: a term is named where it moves a coefficient by more than this many combined standard errors
+NAMED_SIGMAS = 2.0
+
+
+@dataclass(frozen=True)
+class Variant:
+    name: str
+    keep: tuple[str, ...]
+    meaning: str
+
+
+VARIANTS = (
+    Variant("similar", (), "every group of the 1g case (time, soil and wheel moduli scaled)"),
+    Variant("froude", ("soil.youngs_modulus", "wheel.youngs_modulus"),
+            "the 1g case's Froude number; grains and wheel as stiff as at 1/6 g"),
+    Variant("soil-stiffness", ("wheel.youngs_modulus",),
+            "the 1g case's Froude number and grain stiffness; the wheel as stiff as at 1/6 g"),
+)
+
+
+def variant_case(variant: Variant):
+    from wheelsoil.cases.schema import load_case
+    from wheelsoil.cases.similarity import similar_case
+
+    return similar_case(load_case(BASE_CASE), TARGET_GRAVITY, keep=variant.keep, name=f"gravity-{variant.name}")
+
+
+def variant_replicas(variant: Variant, runs: Path, seeds):
+    from wheelsoil.cases.replicas import make_replicas
+
+    return make_replicas(variant_case(variant), seeds, runs / "gravity-terms" / variant.name)
+
+
+def cmd_run(args) -> int:
+    from wheelsoil.cases.sweep import Sweep, run_sweep
+
+    runs = Path(args.runs)
+    seeds = [int(s) for s in args.seeds]
+    every = {v.name: variant_replicas(v, runs, seeds if len(seeds) > 1 else seeds * 2) for v in VARIANTS}  # validated
+    for seed in seeds:  # every variant's first seed before any second: the terms first, their spread after
+        for v in VARIANTS:
+            full = every[v.name]
+            case = next(c for c in full.cases if c.values["case.seed"] == seed)
+            print(f"{v.name}, seed {seed}: {'finished before' if case.finished else 'running'} ({case.folder})",
+                  flush=True)
+            if not case.finished:
+                run_sweep(Sweep(name=full.name, cases=[case], out=full.out, swept_keys=full.swept_keys), workers=1)
+    return 0
+
+
+def _coefficient(quantity: str, value: float, load: float) -> float:
+    scale = {"W": load, "Wr": load * WHEEL_RADIUS, "r": WHEEL_RADIUS}[COEFFICIENTS[quantity][1]]
+    return value / scale  # forces [N], torque [N m], sinkage [m] as the summaries store them
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One condition's steady runs, each as {quantity: coefficient}."""
+
+    name: str
+    runs: list[dict]
+    source: str
+
+    def mean(self, q: str) -> float:
+        return float(np.mean([r[q] for r in self.runs]))
+
+    def n(self) -> int:
+        return len(self.runs)
+
+    def spread(self, q: str) -> float:
+        return float(np.std([r[q] for r in self.runs], ddof=1)) if self.n() > 1 else math.nan
+
+
+def baseline(name: str, path: Path) -> Condition:
+    data = json.loads(path.read_text())
+    load = 3000.0 if name == "earth" else 500.0
+    qs = data["quantities"]
+    n = len(qs["drawbar_pull"]["values"])
+    runs = [{q: _coefficient(q, qs[q]["values"][k], load) for q in COEFFICIENTS} for k in range(n)]
+    return Condition(name, runs, str(path.relative_to(ROOT)))
+
+
+def variant_condition(variant: Variant, runs: Path, seeds) -> Condition:
+    from wheelsoil.cases.results import load_result
+
+    sweep = variant_replicas(variant, runs, seeds if len(seeds) > 1 else seeds * 2)
+    rows = []
+    for c in sweep.cases:
+        path = c.folder / "result.h5"
+        if not path.is_file():
+            continue
+        summary = load_result(path).summary
+        if not summary.steady:
+            continue
+        load = c.case.test.load
+        rows.append({q: _coefficient(q, summary.quantity(q).mean, load) for q in COEFFICIENTS})
+    return Condition(variant.name, rows, str(sweep.out))
+
+
+def pooled_spread(conditions: list[Condition], q: str) -> float:
+    """The run-to-run standard deviation of a coefficient, pooled over every condition with two runs or more."""
+    num = sum((c.n() - 1) * c.spread(q) ** 2 for c in conditions if c.n() > 1)
+    dof = sum(c.n() - 1 for c in conditions if c.n() > 1)
+    return math.sqrt(num / dof) if dof else math.nan
+
+
+def term(a: Condition, b: Condition, q: str, spread: float) -> dict:
+    """b - a in coefficient q, its standard error from the pooled run-to-run spread, and whether it is named."""
+    if not a.n() or not b.n():
+        return {"change": None, "se": None, "named": None}
+    change = b.mean(q) - a.mean(q)
+    se = spread * math.sqrt(1.0 / a.n() + 1.0 / b.n())
+    return {"change": change, "se": se, "named": bool(abs(change) > NAMED_SIGMAS * se)}
+
+
+#: the chain of single-group steps, then the check of the whole transform
+STEPS = (("moon", "froude", "inertia (Froude number)"), ("froude", "soil-stiffness", "grain stiffness"),
+         ("soil-stiffness", "similar", "wheel stiffness"), ("earth", "similar", "similarity check (must be 0)"),
+         ("earth", "moon", "all of them: 1/6 g at equal mass"))
+
+
+def analyse(conditions: dict[str, Condition]) -> dict:
+    spreads = {q: pooled_spread(list(conditions.values()), q) for q in COEFFICIENTS}
+    steps = []
+    for a, b, label in STEPS:
+        steps.append({"from": a, "to": b, "term": label,
+                      **{q: term(conditions[a], conditions[b], q, spreads[q]) for q in COEFFICIENTS}})
+    return {"spreads": spreads, "steps": steps,
+            "conditions": {k: {"runs": c.n(), "source": c.source,
+                               "means": {q: (c.mean(q) if c.n() else None) for q in COEFFICIENTS}}
+                           for k, c in conditions.items()}}
+
+
+def _fmt(x, digits=4):
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:+.{digits}f}"
+
+
+def markdown(result: dict) -> str:
+    lines = ["| condition | runs | " + " | ".join(n for n, _ in COEFFICIENTS.values()) + " |",
+             "|---|---|" + "---|" * len(COEFFICIENTS)]
+    for k, c in result["conditions"].items():
+        lines.append(f"| {k} | {c['runs']} | " + " | ".join(_fmt(c["means"][q]) for q in COEFFICIENTS) + " |")
+    lines += ["", "Run-to-run spread (pooled standard deviation): " + ", ".join(
+        f"{COEFFICIENTS[q][0]} {result['spreads'][q]:.4f}" for q in COEFFICIENTS), "",
+        "| step | term | " + " | ".join(n for n, _ in COEFFICIENTS.values()) + " |",
+        "|---|---|" + "---|" * len(COEFFICIENTS)]
+    for s in result["steps"]:
+        cells = []
+        for q in COEFFICIENTS:
+            t = s[q]
+            cells.append("–" if t["change"] is None else
+                         f"{_fmt(t['change'])} ± {t['se']:.4f}{' **named**' if t['named'] else ''}")
+        lines.append(f"| {s['from']} → {s['to']} | {s['term']} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def cmd_report(args) -> int:
+    runs, out = Path(args.runs), Path(args.out)
+    seeds = [int(s) for s in args.seeds]
+    conditions = {name: baseline(name, path) for name, path in BASELINES.items()}
+    for v in VARIANTS:
+        conditions[v.name] = variant_condition(v, runs, seeds)
+    result = analyse(conditions)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "terms.json").write_text(json.dumps(result, indent=1) + "\n")
+    (out / "terms.md").write_text(markdown(result))
+    print(markdown(result))
+    return 0
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(required=True)
+    r = sub.add_parser("run", help="run the variants, seed by seed (resumable)")
+    r.add_argument("--runs", required=True)
+    r.add_argument("--seeds", nargs="+", default=["0", "1"])
+    r.set_defaults(func=cmd_run)
+    q = sub.add_parser("report", help="the terms table from the finished runs and the stored replicas")
+    q.add_argument("--runs", required=True)
+    q.add_argument("--seeds", nargs="+", default=["0", "1"])
+    q.add_argument("--out", default=str(ROOT / "docs" / "gravity-terms"))
+    q.set_defaults(func=cmd_report)
+    args = p.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
