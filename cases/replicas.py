@@ -65,14 +65,16 @@ def make_replicas(base: CaseFile, seeds, out: str | Path) -> Sweep:
     """The sweep of the base case over ``case.seed`` (every replica validated before anything runs)."""
     seeds = check_seeds(seeds)
     out = Path(out)
-    data = base.model_dump(mode="json")
-    cases = []
-    for seed in seeds:
-        d = apply_overrides(data, [(["case", "seed"], seed)])
-        d["case"]["name"] = f"{base.name}-seed{seed}"
-        case = validate_case(d, f"replica of {base.name}, seed {seed}")
-        cases.append(SweepCase(values={"case.seed": seed}, case=case, folder=out / "cases" / case.case_hash()))
-    return Sweep(name=f"replicas-{base.name}", cases=cases, out=out, swept_keys=["case.seed"])
+    return Sweep(name=f"replicas-{base.name}", cases=[replica(base, seed, out) for seed in seeds], out=out,
+                 swept_keys=["case.seed"])
+
+
+def replica(base: CaseFile, seed: int, out: str | Path) -> SweepCase:
+    """The replica of ``base`` on seed ``seed``: its case (validated) and its folder in the replica set ``out``."""
+    d = apply_overrides(base.model_dump(mode="json"), [(["case", "seed"], int(seed))])
+    d["case"]["name"] = f"{base.name}-seed{seed}"
+    case = validate_case(d, f"replica of {base.name}, seed {seed}")
+    return SweepCase(values={"case.seed": int(seed)}, case=case, folder=Path(out) / "cases" / case.case_hash())
 
 
 def _summaries(sweep: Sweep) -> list[tuple[int, RunSummary | None]]:

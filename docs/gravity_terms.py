@@ -65,10 +65,13 @@ def variant_case(variant: Variant):
     return similar_case(load_case(BASE_CASE), TARGET_GRAVITY, keep=variant.keep, name=f"gravity-{variant.name}")
 
 
-def variant_replicas(variant: Variant, runs: Path, seeds):
-    from wheelsoil.cases.replicas import make_replicas
+def variant_runs(variant: Variant, runs: Path, seeds) -> list:
+    """The variant's run on each seed (a replica set under RUNS/gravity-terms/<variant>: ``wheelsoil replicate
+    --report-only`` reads it)."""
+    from wheelsoil.cases.replicas import replica
 
-    return make_replicas(variant_case(variant), seeds, runs / "gravity-terms" / variant.name)
+    base = variant_case(variant)
+    return [replica(base, seed, runs / "gravity-terms" / variant.name) for seed in seeds]
 
 
 def cmd_run(args) -> int:
@@ -76,15 +79,15 @@ def cmd_run(args) -> int:
 
     runs = Path(args.runs)
     seeds = [int(s) for s in args.seeds]
-    every = {v.name: variant_replicas(v, runs, seeds if len(seeds) > 1 else seeds * 2) for v in VARIANTS}  # validated
-    for seed in seeds:  # every variant's first seed before any second: the terms first, their spread after
+    every = {v.name: variant_runs(v, runs, seeds) for v in VARIANTS}  # every case validated before any runs
+    for k, seed in enumerate(seeds):  # every variant's first seed before any second: the terms first, the spread after
         for v in VARIANTS:
-            full = every[v.name]
-            case = next(c for c in full.cases if c.values["case.seed"] == seed)
+            case = every[v.name][k]
             print(f"{v.name}, seed {seed}: {'finished before' if case.finished else 'running'} ({case.folder})",
                   flush=True)
             if not case.finished:
-                run_sweep(Sweep(name=full.name, cases=[case], out=full.out, swept_keys=full.swept_keys), workers=1)
+                run_sweep(Sweep(name=f"gravity-{v.name}", cases=[case], out=case.folder.parent.parent,
+                                swept_keys=["case.seed"]), workers=1)
     return 0
 
 
@@ -100,6 +103,8 @@ class Condition:
     name: str
     runs: list[dict]
     source: str
+    #: runs that found no steady window by the end of their drive: their last window, for information only
+    unsteady: tuple[dict, ...] = ()
 
     def mean(self, q: str) -> float:
         return float(np.mean([r[q] for r in self.runs]))
@@ -123,18 +128,19 @@ def baseline(name: str, path: Path) -> Condition:
 def variant_condition(variant: Variant, runs: Path, seeds) -> Condition:
     from wheelsoil.cases.results import load_result
 
-    sweep = variant_replicas(variant, runs, seeds if len(seeds) > 1 else seeds * 2)
-    rows = []
-    for c in sweep.cases:
+    rows, unsteady = [], []
+    for c in variant_runs(variant, runs, seeds):
         path = c.folder / "result.h5"
         if not path.is_file():
             continue
         summary = load_result(path).summary
-        if not summary.steady:
-            continue
-        load = c.case.test.load
-        rows.append({q: _coefficient(q, summary.quantity(q).mean, load) for q in COEFFICIENTS})
-    return Condition(variant.name, rows, str(sweep.out))
+        row = {q: _coefficient(q, summary.quantity(q).mean, c.case.test.load) for q in COEFFICIENTS}
+        if summary.steady:
+            rows.append(row)
+        else:
+            unsteady.append({"seed": c.values["case.seed"], "window": list(summary.window),
+                             "reasons": list(summary.reasons), **row})
+    return Condition(variant.name, rows, str(runs / "gravity-terms" / variant.name), tuple(unsteady))
 
 
 def pooled_spread(conditions: list[Condition], q: str) -> float:
@@ -167,7 +173,8 @@ def analyse(conditions: dict[str, Condition]) -> dict:
                       **{q: term(conditions[a], conditions[b], q, spreads[q]) for q in COEFFICIENTS}})
     return {"spreads": spreads, "steps": steps,
             "conditions": {k: {"runs": c.n(), "source": c.source,
-                               "means": {q: (c.mean(q) if c.n() else None) for q in COEFFICIENTS}}
+                               "means": {q: (c.mean(q) if c.n() else None) for q in COEFFICIENTS},
+                               "not_steady": list(c.unsteady)}
                            for k, c in conditions.items()}}
 
 
@@ -191,6 +198,15 @@ def markdown(result: dict) -> str:
             cells.append("–" if t["change"] is None else
                          f"{_fmt(t['change'])} ± {t['se']:.4f}{' **named**' if t['named'] else ''}")
         lines.append(f"| {s['from']} → {s['to']} | {s['term']} | " + " | ".join(cells) + " |")
+    unsteady = [(k, u) for k, c in result["conditions"].items() for u in c["not_steady"]]
+    if unsteady:
+        lines += ["", "Not steady by the end of their drive (their last window, for information only: not a number "
+                  "by the rule, and not in the tables above):", "",
+                  "| condition | seed | window [s] | " + " | ".join(n for n, _ in COEFFICIENTS.values()) + " | why |",
+                  "|---|---|---|" + "---|" * len(COEFFICIENTS) + "---|"]
+        for k, u in unsteady:
+            lines.append(f"| {k} | {u['seed']} | {u['window'][0]:.2f}–{u['window'][1]:.2f} | "
+                         + " | ".join(_fmt(u[q]) for q in COEFFICIENTS) + f" | {'; '.join(u['reasons'])} |")
     return "\n".join(lines) + "\n"
 
 

@@ -36,6 +36,7 @@ def test_a_docs_script_loads_and_its_wheelsoil_imports_exist(script, monkeypatch
 def _load(name: str):
     spec = importlib.util.spec_from_file_location(f"docs_{name}", DOCS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # a script's dataclasses look their module up while they are made
     spec.loader.exec_module(module)
     return module
 
@@ -493,3 +494,30 @@ def test_the_calibration_figure_draws_the_stored_candidates_and_refuses_a_folder
     assert calibration.main(["figure", folder, "--design", "epsd", "--png", str(tmp_path / "no.png"),
                              "--seed-plates", str(tmp_path)]) == 1
     assert not (tmp_path / "no.png").exists()
+
+
+def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors():
+    gt = _load("gravity_terms")
+    qs = list(gt.COEFFICIENTS)
+
+    def condition(name, dp_values):
+        return gt.Condition(name, [{q: (v if q == "drawbar_pull" else 0.1) for q in qs} for v in dp_values], "test")
+
+    conditions = {"earth": condition("earth", [0.30, 0.32, 0.31]), "moon": condition("moon", [0.18, 0.19, 0.17]),
+                  "froude": condition("froude", [0.285, 0.295]), "soil-stiffness": condition("soil-stiffness", [0.30]),
+                  "similar": condition("similar", [0.31, 0.31])}
+    result = gt.analyse(conditions)
+    # pooled over every condition with two runs or more: (2*1e-4 + 2*1e-4 + 5e-5 + 0) / (2 + 2 + 1 + 1)
+    assert result["spreads"]["drawbar_pull"] == pytest.approx(np.sqrt((2e-4 + 2e-4 + 5e-5) / 6))
+    steps = {s["term"]: s["drawbar_pull"] for s in result["steps"]}
+    s = result["spreads"]["drawbar_pull"]
+    inertia = steps["inertia (Froude number)"]
+    assert inertia["change"] == pytest.approx(0.29 - 0.18)
+    assert inertia["se"] == pytest.approx(s * np.sqrt(1 / 3 + 1 / 2)) and inertia["named"]
+    assert not steps["grain stiffness"]["named"]  # 0.01 against 2 x 0.0106
+    assert not steps["similarity check (must be 0)"]["named"]
+    assert steps["all of them: 1/6 g at equal mass"]["named"]
+    assert result["steps"][0]["lateral_force"]["change"] == pytest.approx(0.0)
+    empty = dict(conditions, froude=gt.Condition("froude", [], "test"))
+    assert gt.analyse(empty)["steps"][0]["drawbar_pull"] == {"change": None, "se": None, "named": None}
+    assert "| froude | 0 |" in gt.markdown(gt.analyse(empty))

@@ -97,3 +97,66 @@ def test_every_unit_of_the_case_schema_has_a_time_exponent():
             if isinstance(extra, dict) and extra.get("unit"):
                 units.add(extra["unit"])
     assert units <= set(TIME_EXPONENT), units - set(TIME_EXPONENT)
+
+
+@pytest.mark.slow  # two runs of the mini testbed, ~2 min
+def test_the_coupled_testbed_at_a_sixth_of_gravity_with_scaled_units_is_the_same_run(bed_cache):
+    """The mini case and its similar case at 1/6 g (``similar_case``) on the same bed (velocities / tau, rolling
+    torques / 6; the bin walls' modulus / 6 too, which the case cannot reach): the wheel pressed into the soil gives the
+    same forces times 6 at the same rows. The wheel in dense soil amplifies round-off fast (a 1e-15 change of the bed's
+    velocities grows to 1e-9 of the load by 0.04 s and to the load's own size by 0.3 s), so the rows up to 0.04 s are
+    held to 1e-7 of the largest force: the scaled run stayed within 6e-10 of it; with the walls left at 210 GPa it is
+    6e-7 off, with the wheel's damping unscaled 1e-2."""
+    import dataclasses
+
+    from wheelsoil.cases import build
+    from wheelsoil.coupling.testbed import Testbed
+    from wheelsoil.granular import prepare_bed
+
+    settings = ["soil.periodic=false", "soil.time_step=4e-5", "test.drive_time=0.08", "test.stop_when_steady=false",
+                "output.average_time=0.02", "output.frame_interval=0", "output.checkpoint_interval=0",
+                "output.render=false"]  # the DEM step set: the stable estimate binds differently at each gravity
+    base = load_case("mini-1g-steer", settings)
+    moon = similar_case(base, "moon")
+    bed_e, wheel_e, run_e = build.specs(base)
+    bed_m, wheel_m, run_m = build.specs(moon)
+    walls = _scaled(bed_m.wall_material, 1 / 6)
+    bed = prepare_bed(bed_e, cache_dir=bed_cache)
+    history = dataclasses.replace(bed.history, pair_roll=bed.history.pair_roll / 6,
+                                  roll_wall=bed.history.roll_wall / 6)
+    bed_moon = dataclasses.replace(bed, spec=dataclasses.replace(bed_m, wall_material=walls),
+                                   velocities=bed.velocities / TAU, angular_velocities=bed.angular_velocities / TAU,
+                                   history=history)
+    earth = Testbed(bed, wheel_e, run_e).run()
+    scaled = Testbed(bed_moon, wheel_m, run_m).run()
+    assert scaled.info["dem_time_step"] == pytest.approx(earth.info["dem_time_step"] * TAU, rel=1e-12)
+    assert scaled.info["dem_steps"] == earth.info["dem_steps"]
+    t = earth.series["t"]
+    np.testing.assert_allclose(scaled.series["t"] / TAU, t, rtol=1e-12, atol=1e-12)
+    early = t <= 0.04 + 1e-9
+    assert early.sum() >= 8
+    assert earth.series["vertical_force"][early].max() > 5.0  # the wheel is in the soil within the rows compared
+    for name in ("vertical_force", "drawbar_pull", "lateral_force", "torque"):
+        a, b = earth.series[name], scaled.series[name] * 6.0
+        scale = np.abs(a).max()
+        assert np.abs(b[early] - a[early]).max() <= 1e-7 * scale, name
+    np.testing.assert_allclose(scaled.series["sinkage"][early], earth.series["sinkage"][early], rtol=0, atol=1e-9)
+
+
+def test_the_case_command_prints_the_similar_case_and_refuses_bad_input(tmp_path, capsys):
+    from wheelsoil.cases.cli import EXIT_INPUT, EXIT_OK, main
+
+    assert main(["case", "similar", "smoke-1g-steer", "--gravity", "moon", "--keep", "soil.youngs_modulus"]) == EXIT_OK
+    text = capsys.readouterr().out
+    path = tmp_path / "moon.toml"
+    path.write_text(text)
+    printed = load_case(str(path))
+    expected = similar_case(load_case("smoke-1g-steer"), "moon", keep=("soil.youngs_modulus",))
+    assert printed.case_hash() == expected.case_hash()
+    for argv, needle in ((["case", "similar", "smoke-1g-steer"], "needs --gravity"),
+                         (["case", "similar", "smoke-1g-steer", "--gravity", "2000"], "(0, 1000)"),
+                         (["case", "similar", "smoke-1g-steer", "--gravity", "moon", "--keep", "soil.density"],
+                          "soil.density")):
+        assert main(argv) == EXIT_INPUT
+        err = capsys.readouterr().err
+        assert needle in err and "Traceback" not in err, err
