@@ -42,8 +42,11 @@ start "wide-box calibration, then its choice's checks (issue 33)" \
 # docs/sweeps/seed004-like/README.md), then seed 001's wheel and slips, flexible against rigid (10 cases, hours each;
 # docs/sweeps/seed001-flexible-rigid/README.md). Finished cases are kept and a killed one resumes from its checkpoint;
 # when cases finish, their tables are written into those folders (the commands are in their READMEs).
-start "issue 35's sweeps: seed004-like, then seed001-flexible-rigid" \
-  "batch seed004-like|batch seed001-flexible-rigid" "$RUNS/issue35-sweeps.log" \
-  bash -c '"$0" -m wheelsoil.cases.cli batch seed004-like --out "$1/seed004-like" --workers 1; \
+# First in that slot since 2026-11-30: the gravity terms (docs/gravity-terms/README.md; nine smoke runs of 15-60 min,
+# each variant's seeds 0, 1, 2 in turn; its log $RUNS/gravity-terms.log).
+start "issue 35's sweeps: gravity-terms, seed004-like, then seed001-flexible-rigid" \
+  "gravity_terms.py run|batch seed004-like|batch seed001-flexible-rigid" "$RUNS/issue35-sweeps.log" \
+  bash -c '"$0" docs/gravity_terms.py run --runs "$1" --seeds 0 1 2 >> "$1/gravity-terms.log" 2>&1; \
+    "$0" -m wheelsoil.cases.cli batch seed004-like --out "$1/seed004-like" --workers 1; \
     "$0" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$1/seed001-flexible-rigid" --workers 1' \
   "$PY" "$RUNS"
