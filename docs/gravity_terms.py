@@ -210,6 +210,37 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def figure(result: dict, path: Path) -> None:
+    """One panel per coefficient: each condition's mean with one standard error (the pooled spread / sqrt(n)), the
+    chain's order from 1/6 g at equal mass (left) to the similar case and the 1g replicas (right)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    order = ["moon", "froude", "soil-stiffness", "similar", "earth"]
+    labels = ["1/6 g, 500 N", "+ Froude", "+ grain\nstiffness", "+ wheel\nstiffness\n(similar)", "1g, 3000 N"]
+    fig, axes = plt.subplots(1, len(COEFFICIENTS), figsize=(4.0 * len(COEFFICIENTS), 3.6))
+    for ax, q in zip(axes, COEFFICIENTS):
+        means = [result["conditions"][k]["means"][q] for k in order]
+        runs = [result["conditions"][k]["runs"] for k in order]
+        spread = result["spreads"][q]
+        for x, (m, n) in enumerate(zip(means, runs)):
+            if m is not None:
+                ax.errorbar(x, m, yerr=spread / math.sqrt(n), fmt="o", color="C3" if order[x] == "earth" else "C0",
+                            capsize=3)
+            for u in result["conditions"][order[x]]["not_steady"]:  # for information: hollow, no error bar
+                ax.plot(x + 0.12, u[q], "o", mfc="none", color="0.5")
+        ax.set_xticks(range(len(order)), labels, fontsize=7)
+        ax.set_title(COEFFICIENTS[q][0])
+        ax.grid(alpha=0.3)
+    fig.suptitle("smoke case, slip 0.3, 10 deg: the groups of 1/6 g at equal mass restored one by one "
+                 "(hollow: runs not steady, for information)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def cmd_report(args) -> int:
     runs, out = Path(args.runs), Path(args.out)
     seeds = [int(s) for s in args.seeds]
@@ -220,6 +251,7 @@ def cmd_report(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     (out / "terms.json").write_text(json.dumps(result, indent=1) + "\n")
     (out / "terms.md").write_text(markdown(result))
+    figure(result, out / "terms.png")
     print(markdown(result))
     return 0
 
