@@ -496,7 +496,7 @@ def test_the_calibration_figure_draws_the_stored_candidates_and_refuses_a_folder
     assert not (tmp_path / "no.png").exists()
 
 
-def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors():
+def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path):
     gt = _load("gravity_terms")
     qs = list(gt.COEFFICIENTS)
 
@@ -518,6 +518,10 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors():
     assert not steps["similarity check (must be 0)"]["named"]
     assert steps["all of them: 1/6 g at equal mass"]["named"]
     assert result["steps"][0]["lateral_force"]["change"] == pytest.approx(0.0)
-    empty = dict(conditions, froude=gt.Condition("froude", [], "test"))
+    unsteady = ({"seed": 4, "window": [1.0, 2.0], "reasons": ["drawbar_pull drifts"], **{q: 0.25 for q in qs}},)
+    empty = dict(conditions, froude=gt.Condition("froude", [], "test", unsteady))
     assert gt.analyse(empty)["steps"][0]["drawbar_pull"] == {"change": None, "se": None, "named": None}
-    assert "| froude | 0 |" in gt.markdown(gt.analyse(empty))
+    text = gt.markdown(gt.analyse(empty))
+    assert "| froude | 0 |" in text and "| froude | 4 | 1.00–2.00 | +0.2500" in text and "drawbar_pull drifts" in text
+    gt.figure(gt.analyse(empty), tmp_path / "terms.png")
+    assert (tmp_path / "terms.png").stat().st_size > 10_000
