@@ -44,9 +44,14 @@ NAMED_SIGMAS = 2.0
 
 @dataclass(frozen=True)
 class Variant:
+    """A run of the study: the 1g case carried to 1/6 g keeping the keys ``keep`` (``preset`` None), or a preset with
+    ``overrides`` as it is (the rigid-wheel check)."""
+
     name: str
     keep: tuple[str, ...]
     meaning: str
+    preset: str | None = None
+    overrides: tuple[str, ...] = ()
 
 
 VARIANTS = (
@@ -55,6 +60,11 @@ VARIANTS = (
             "the 1g case's Froude number; grains and wheel as stiff as at 1/6 g"),
     Variant("soil-stiffness", ("wheel.youngs_modulus",),
             "the 1g case's Froude number and grain stiffness; the wheel as stiff as at 1/6 g"),
+    # added on 2026-11-30 (00:31) after the first three runs, before running them: the conclusion they point to (the
+    # wheel's stiffness is the term) checked on a wheel that cannot deflect, at both gravities at equal mass
+    Variant("rigid-earth", (), "the rigid wheel of the same surface, 1g, W = 3000 N", BASE_CASE, ("wheel.rigid=true",)),
+    Variant("rigid-moon", (), "the rigid wheel of the same surface, 1/6 g, W = 500 N", "smoke-moon-steer",
+            ("wheel.rigid=true",)),
 )
 
 
@@ -62,6 +72,8 @@ def variant_case(variant: Variant):
     from wheelsoil.cases.schema import load_case
     from wheelsoil.cases.similarity import similar_case
 
+    if variant.preset is not None:
+        return load_case(variant.preset, list(variant.overrides), name=f"gravity-{variant.name}")
     return similar_case(load_case(BASE_CASE), TARGET_GRAVITY, keep=variant.keep, name=f"gravity-{variant.name}")
 
 
@@ -75,17 +87,31 @@ def variant_runs(variant: Variant, runs: Path, seeds) -> list:
 
 
 def cmd_run(args) -> int:
+    import fcntl
+
     from wheelsoil.cases.sweep import Sweep, run_sweep
 
     runs = Path(args.runs)
     seeds = [int(s) for s in args.seeds]
-    every = {v.name: variant_runs(v, runs, seeds) for v in VARIANTS}  # every case validated before any runs
+    chosen = [v for v in VARIANTS if not args.variants or v.name in args.variants]
+    unknown = set(args.variants or ()) - {v.name for v in VARIANTS}
+    if unknown:
+        raise SystemExit(f"--variants {sorted(unknown)}: not variants of the study ({[v.name for v in VARIANTS]})")
+    every = {v.name: variant_runs(v, runs, seeds) for v in chosen}  # every case validated before any runs
     for k, seed in enumerate(seeds):  # every variant's first seed before any second: the terms first, the spread after
-        for v in VARIANTS:
+        for v in chosen:
             case = every[v.name][k]
-            print(f"{v.name}, seed {seed}: {'finished before' if case.finished else 'running'} ({case.folder})",
-                  flush=True)
-            if not case.finished:
+            if case.finished:
+                print(f"{v.name}, seed {seed}: finished before ({case.folder})", flush=True)
+                continue
+            case.folder.parent.mkdir(parents=True, exist_ok=True)
+            with open(case.folder.parent / f"{case.folder.name}.lock", "w") as lock:
+                try:  # another runner of the study (a second job started by hand) may hold this case
+                    fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                except BlockingIOError:
+                    print(f"{v.name}, seed {seed}: running in another job; skipped here", flush=True)
+                    continue
+                print(f"{v.name}, seed {seed}: running ({case.folder})", flush=True)
                 run_sweep(Sweep(name=f"gravity-{v.name}", cases=[case], out=case.folder.parent.parent,
                                 swept_keys=["case.seed"]), workers=1)
     return 0
@@ -162,7 +188,8 @@ def term(a: Condition, b: Condition, q: str, spread: float) -> dict:
 #: the chain of single-group steps, then the check of the whole transform
 STEPS = (("moon", "froude", "inertia (Froude number)"), ("froude", "soil-stiffness", "grain stiffness"),
          ("soil-stiffness", "similar", "wheel stiffness"), ("earth", "similar", "similarity check (must be 0)"),
-         ("earth", "moon", "all of them: 1/6 g at equal mass"))
+         ("earth", "moon", "all of them: 1/6 g at equal mass"),
+         ("rigid-earth", "rigid-moon", "1/6 g at equal mass, rigid wheel (the wheel's term removed)"))
 
 
 def analyse(conditions: dict[str, Condition]) -> dict:
@@ -262,6 +289,7 @@ def main(argv=None) -> int:
     r = sub.add_parser("run", help="run the variants, seed by seed (resumable)")
     r.add_argument("--runs", required=True)
     r.add_argument("--seeds", nargs="+", default=["0", "1"])
+    r.add_argument("--variants", nargs="+", help="run only these variants (default: all, in the study's order)")
     r.set_defaults(func=cmd_run)
     q = sub.add_parser("report", help="the terms table from the finished runs and the stored replicas")
     q.add_argument("--runs", required=True)
