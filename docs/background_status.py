@@ -88,8 +88,8 @@ def campaign_lines() -> list[str]:
 
 
 #: Issue 35's sweeps that ``docs/background.sh`` runs, by their folder under RUNS.
-SWEEPS = ("gravity-terms/similar", "gravity-terms/froude", "gravity-terms/soil-stiffness", "seed004-full-scale",
-          "seed004-like", "seed001-flexible-rigid")
+SWEEPS = ("gravity-terms/similar", "gravity-terms/froude", "gravity-terms/soil-stiffness", "gravity-terms/rigid-earth",
+          "gravity-terms/rigid-moon", "seed004-full-scale", "seed004-like", "seed001-flexible-rigid")
 
 
 def sweep_lines(runs: Path) -> list[str]:
