@@ -245,17 +245,19 @@ def figure(result: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    order = ["moon", "froude", "soil-stiffness", "similar", "earth"]
-    labels = ["1/6 g, 500 N", "+ Froude", "+ grain\nstiffness", "+ wheel\nstiffness\n(similar)", "1g, 3000 N"]
-    fig, axes = plt.subplots(1, len(COEFFICIENTS), figsize=(4.0 * len(COEFFICIENTS), 3.6))
+    order = ["moon", "froude", "soil-stiffness", "similar", "earth", "rigid-moon", "rigid-earth"]
+    labels = ["1/6 g, 500 N", "+ Froude", "+ grain\nstiffness", "+ wheel\nstiffness\n(similar)", "1g, 3000 N",
+              "rigid,\n1/6 g", "rigid,\n1g"]
+    fig, axes = plt.subplots(1, len(COEFFICIENTS), figsize=(4.6 * len(COEFFICIENTS), 3.8))
     for ax, q in zip(axes, COEFFICIENTS):
         means = [result["conditions"][k]["means"][q] for k in order]
         runs = [result["conditions"][k]["runs"] for k in order]
         spread = result["spreads"][q]
         for x, (m, n) in enumerate(zip(means, runs)):
             if m is not None:
-                ax.errorbar(x, m, yerr=spread / math.sqrt(n), fmt="o", color="C3" if order[x] == "earth" else "C0",
-                            capsize=3)
+                color = "C3" if order[x] in ("earth", "rigid-earth") else "C0"
+                ax.errorbar(x, m, yerr=spread / math.sqrt(n), fmt="s" if order[x].startswith("rigid") else "o",
+                            color=color, capsize=3)
             for u in result["conditions"][order[x]]["not_steady"]:  # for information: hollow, no error bar
                 ax.plot(x + 0.12, u[q], "o", mfc="none", color="0.5")
         ax.set_xticks(range(len(order)), labels, fontsize=7)

@@ -505,7 +505,8 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path)
 
     conditions = {"earth": condition("earth", [0.30, 0.32, 0.31]), "moon": condition("moon", [0.18, 0.19, 0.17]),
                   "froude": condition("froude", [0.285, 0.295]), "soil-stiffness": condition("soil-stiffness", [0.30]),
-                  "similar": condition("similar", [0.31, 0.31])}
+                  "similar": condition("similar", [0.31, 0.31]), "rigid-earth": condition("rigid-earth", [0.16]),
+                  "rigid-moon": condition("rigid-moon", [0.15])}
     result = gt.analyse(conditions)
     # pooled over every condition with two runs or more: (2*1e-4 + 2*1e-4 + 5e-5 + 0) / (2 + 2 + 1 + 1)
     assert result["spreads"]["drawbar_pull"] == pytest.approx(np.sqrt((2e-4 + 2e-4 + 5e-5) / 6))
@@ -517,6 +518,7 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path)
     assert not steps["grain stiffness"]["named"]  # 0.01 against 2 x 0.0106
     assert not steps["similarity check (must be 0)"]["named"]
     assert steps["all of them: 1/6 g at equal mass"]["named"]
+    assert steps["1/6 g at equal mass, rigid wheel (the wheel's term removed)"]["change"] == pytest.approx(-0.01)
     assert result["steps"][0]["lateral_force"]["change"] == pytest.approx(0.0)
     unsteady = ({"seed": 4, "window": [1.0, 2.0], "reasons": ["drawbar_pull drifts"], **{q: 0.25 for q in qs}},)
     empty = dict(conditions, froude=gt.Condition("froude", [], "test", unsteady))
