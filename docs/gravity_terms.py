@@ -151,22 +151,38 @@ def baseline(name: str, path: Path) -> Condition:
     return Condition(name, runs, str(path.relative_to(ROOT)))
 
 
-def variant_condition(variant: Variant, runs: Path, seeds) -> Condition:
+def variant_records(variant: Variant, runs: Path, seeds, recorded: dict) -> dict:
+    """{seed: record} of the variant's finished runs: read from their result files under RUNS where they are, else kept
+    from ``recorded`` (the study's ``runs.json`` in the repository: a machine replaced between sessions takes the runs'
+    files with it, not their records). A record holds the case hash, the verdict, the window, the reasons, the raw
+    steady means (forces [N], torque [N m], sinkage [m]) and the coefficients."""
     from wheelsoil.cases.results import load_result
 
-    rows, unsteady = [], []
+    out = {}
     for c in variant_runs(variant, runs, seeds):
+        seed = c.values["case.seed"]
         path = c.folder / "result.h5"
-        if not path.is_file():
-            continue
-        summary = load_result(path).summary
-        row = {q: _coefficient(q, summary.quantity(q).mean, c.case.test.load) for q in COEFFICIENTS}
-        if summary.steady:
-            rows.append(row)
+        if path.is_file():
+            summary = load_result(path).summary
+            means = {q: summary.quantity(q).mean for q in (*COEFFICIENTS, "tread_sinkage", "vertical_force")}
+            out[str(seed)] = {"case_hash": c.folder.name, "steady": bool(summary.steady),
+                              "window": list(summary.window), "reasons": list(summary.reasons), "means": means,
+                              "coefficients": {q: _coefficient(q, means[q], c.case.test.load) for q in COEFFICIENTS}}
+        elif str(seed) in recorded and recorded[str(seed)]["case_hash"] == c.folder.name:
+            out[str(seed)] = dict(recorded[str(seed)], recorded="earlier")
+    return out
+
+
+def variant_condition(variant: Variant, records: dict) -> Condition:
+    """The variant's steady runs as coefficients, the others apart (for information)."""
+    rows, unsteady = [], []
+    for seed, rec in sorted(records.items(), key=lambda kv: int(kv[0])):
+        if rec["steady"]:
+            rows.append(dict(rec["coefficients"]))
         else:
-            unsteady.append({"seed": c.values["case.seed"], "window": list(summary.window),
-                             "reasons": list(summary.reasons), **row})
-    return Condition(variant.name, rows, str(runs / "gravity-terms" / variant.name), tuple(unsteady))
+            unsteady.append({"seed": int(seed), "window": rec["window"], "reasons": rec["reasons"],
+                             **rec["coefficients"]})
+    return Condition(variant.name, rows, f"RUNS/gravity-terms/{variant.name}", tuple(unsteady))
 
 
 def pooled_spread(conditions: list[Condition], q: str) -> float:
@@ -274,10 +290,14 @@ def cmd_report(args) -> int:
     runs, out = Path(args.runs), Path(args.out)
     seeds = [int(s) for s in args.seeds]
     conditions = {name: baseline(name, path) for name, path in BASELINES.items()}
+    record_path = out / "runs.json"
+    recorded = json.loads(record_path.read_text()) if record_path.is_file() else {}
+    records = {v.name: variant_records(v, runs, seeds, recorded.get(v.name, {})) for v in VARIANTS}
     for v in VARIANTS:
-        conditions[v.name] = variant_condition(v, runs, seeds)
+        conditions[v.name] = variant_condition(v, records[v.name])
     result = analyse(conditions)
     out.mkdir(parents=True, exist_ok=True)
+    record_path.write_text(json.dumps(records, indent=1) + "\n")
     (out / "terms.json").write_text(json.dumps(result, indent=1) + "\n")
     (out / "terms.md").write_text(markdown(result))
     figure(result, out / "terms.png")

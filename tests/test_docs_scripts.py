@@ -527,3 +527,17 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path)
     assert "| froude | 0 |" in text and "| froude | 4 | 1.00–2.00 | +0.2500" in text and "drawbar_pull drifts" in text
     gt.figure(gt.analyse(empty), tmp_path / "terms.png")
     assert (tmp_path / "terms.png").stat().st_size > 10_000
+
+
+def test_the_gravity_terms_keep_a_run_recorded_in_the_repository_when_its_files_are_gone(tmp_path):
+    gt = _load("gravity_terms")
+    variant = gt.VARIANTS[0]
+    case = gt.variant_runs(variant, tmp_path, [1])[0]
+    coefficients = {q: 0.2 for q in gt.COEFFICIENTS}
+    rec = {"case_hash": case.folder.name, "steady": True, "window": [1.0, 3.0], "reasons": [], "means": {},
+           "coefficients": coefficients}
+    stale = dict(rec, case_hash="0" * 16)  # a record of another case on that seed (the variant changed): dropped
+    kept = gt.variant_records(variant, tmp_path, [1, 2], {"1": rec, "2": stale})
+    assert list(kept) == ["1"] and kept["1"]["recorded"] == "earlier"
+    condition = gt.variant_condition(variant, dict(kept, **{"3": dict(rec, steady=False, reasons=["drift"])}))
+    assert condition.runs == [coefficients] and condition.unsteady[0]["seed"] == 3
