@@ -8,7 +8,8 @@ from . import common
 
 def add_parser(sub) -> None:
     """The ``case`` command on ``sub``."""
-    p = sub.add_parser("case", help="list the preset cases, show a case with every key, check a case file, or carry a case to another gravity",
+    p = sub.add_parser("case", help="list the preset cases, show a case with every key, check a case file, or carry "
+                                    "a case to another gravity",
                        description="'wheelsoil case list' lists the presets; 'wheelsoil case show CASE' prints the "
                                    "resolved case with every key, its unit, range and default (a template to copy); "
                                    "'wheelsoil case check CASE' validates a case file and prints its hash; "
