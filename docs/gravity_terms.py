@@ -9,9 +9,14 @@ transform with some of its scalings left out; each step from one to the next cha
     moon (the smoke-moon-steer replicas)  -- time scaled -->  froude  -- soil modulus / 6 -->  soil-stiffness
         -- wheel modulus / 6 -->  similar (every group of the 1g case: must give the 1g case's coefficients)
 
-Commands (resumable; each run kept under RUNS/gravity-terms/<variant>/cases/<hash>):
+and, as a check of the conclusion the first runs pointed to, the rigid wheel of the same surface at both gravities
+(rigid-earth, rigid-moon: a wheel that cannot deflect has no stiffness group).
 
-    python docs/gravity_terms.py run --runs RUNS --seeds 0 1        # seed 0 of every variant, then seed 1, ...
+Commands (resumable; each run kept under RUNS/gravity-terms/<variant>/cases/<hash>, a lock beside it so that a second
+runner started with --variants skips a case the first is running; each finished run's values are recorded in
+docs/gravity-terms/runs.json by the report):
+
+    python docs/gravity_terms.py run --runs RUNS --seeds 0 1 2      # seed 0 of every variant, then seed 1, ...
     python docs/gravity_terms.py report --runs RUNS --out docs/gravity-terms
 
 The reading rule is fixed in docs/gravity-terms/README.md before any run.
