@@ -55,11 +55,6 @@ UNSCALED_CONSTANTS = {
 }
 
 
-def _gravity_magnitude(case: CaseFile) -> float:
-    gx, gy, gz = case.soil.gravity_vector
-    return math.sqrt(gx * gx + gy * gy + gz * gz)
-
-
 def _unit(section: str, key: str) -> str | None:
     field = CaseFile.model_fields[section].annotation.model_fields[key]
     extra = field.json_schema_extra
@@ -94,20 +89,20 @@ def similar_case(base: CaseFile, gravity, *, keep: tuple[str, ...] = (), name: s
         raise WheelsoilInputError("similar_case: a case with [protocol] stages is not supported (scale their times)")
     data = base.model_dump(mode="json")
     probe = validate_case(apply_overrides(data, [(["soil", "gravity"], gravity)]), "similar_case gravity")
-    g0, g1 = _gravity_magnitude(base), _gravity_magnitude(probe)
-    tau = math.sqrt(g0 / g1)
+    tau = math.sqrt(build.bed_spec(base).gravity_magnitude / build.bed_spec(probe).gravity_magnitude)
     geometry = build.wheel_geometry(base)
     implicit = {}
     if base.wheel.youngs_modulus is None:
         implicit["wheel.youngs_modulus"] = (geometry.material.youngs_modulus, TIME_EXPONENT["Pa"])
     if base.test.axle_damping is None:
         implicit["test.axle_damping"] = (wheel_mass(geometry) / AXLE_DAMPING_TIME, TIME_EXPONENT["N s/m"])
-    unknown = [k for k in keep if k not in scaled_keys(base) and k not in implicit]
+    explicit = scaled_keys(base)
+    unknown = [k for k in keep if k not in explicit and k not in implicit]
     if unknown:
         raise WheelsoilInputError(f"similar_case keep={unknown}: not a key that the similarity scales "
-                                  f"(those are {sorted(scaled_keys(base)) + sorted(implicit)})")
+                                  f"(those are {sorted(explicit) + sorted(implicit)})")
     overrides = [(["soil", "gravity"], gravity)]
-    for dotted, exponent in scaled_keys(base).items():
+    for dotted, exponent in explicit.items():
         if dotted in keep:
             continue
         section, key = dotted.split(".")

@@ -42,7 +42,6 @@ BASELINES = {"earth": ROOT / "docs/replicas/smoke-1g-steer/replicas.json",
 #: the coefficients compared: quantity -> (name, divided by W, or by W r, or by r)
 COEFFICIENTS = {"drawbar_pull": ("DP / W", "W"), "lateral_force": ("F_y / W", "W"), "torque": ("T / (W r)", "Wr"),
                 "sinkage": ("z / r", "r")}
-WHEEL_RADIUS = 0.6  # m, the lunar-rover wheel's tread radius (seed 004)
 #: a term is named where it moves a coefficient by more than this many combined standard errors
 NAMED_SIGMAS = 2.0
 
@@ -122,9 +121,13 @@ def cmd_run(args) -> int:
     return 0
 
 
-def _coefficient(quantity: str, value: float, load: float) -> float:
-    scale = {"W": load, "Wr": load * WHEEL_RADIUS, "r": WHEEL_RADIUS}[COEFFICIENTS[quantity][1]]
-    return value / scale  # forces [N], torque [N m], sinkage [m] as the summaries store them
+def _coefficient(quantity: str, value: float, case) -> float:
+    """``value`` of ``quantity`` (forces [N], torque [N m], sinkage [m] as the summaries store them) over the load W,
+    W r or r of ``case`` (its tread radius r)."""
+    from wheelsoil.cases import build
+
+    load, radius = case.test.load, build.wheel_geometry(case).radius
+    return value / {"W": load, "Wr": load * radius, "r": radius}[COEFFICIENTS[quantity][1]]
 
 
 @dataclass(frozen=True)
@@ -148,11 +151,15 @@ class Condition:
 
 
 def baseline(name: str, path: Path) -> Condition:
+    """A stored replica set (``wheelsoil replicate``'s replicas.json) as a condition, each run's coefficients taken
+    against its case's load and wheel."""
+    from wheelsoil.cases.schema import load_case
+
     data = json.loads(path.read_text())
-    load = 3000.0 if name == "earth" else 500.0
+    case = load_case(data["case"])
     qs = data["quantities"]
     n = len(qs["drawbar_pull"]["values"])
-    runs = [{q: _coefficient(q, qs[q]["values"][k], load) for q in COEFFICIENTS} for k in range(n)]
+    runs = [{q: _coefficient(q, qs[q]["values"][k], case) for q in COEFFICIENTS} for k in range(n)]
     return Condition(name, runs, str(path.relative_to(ROOT)))
 
 
@@ -172,7 +179,7 @@ def variant_records(variant: Variant, runs: Path, seeds, recorded: dict) -> dict
             means = {q: summary.quantity(q).mean for q in (*COEFFICIENTS, "tread_sinkage", "vertical_force")}
             out[str(seed)] = {"case_hash": c.folder.name, "steady": bool(summary.steady),
                               "window": list(summary.window), "reasons": list(summary.reasons), "means": means,
-                              "coefficients": {q: _coefficient(q, means[q], c.case.test.load) for q in COEFFICIENTS}}
+                              "coefficients": {q: _coefficient(q, means[q], c.case) for q in COEFFICIENTS}}
         elif str(seed) in recorded and recorded[str(seed)]["case_hash"] == c.folder.name:
             out[str(seed)] = dict(recorded[str(seed)], recorded="earlier")
     return out
