@@ -15,6 +15,8 @@ Layout (``../shared/docs/architecture.md``; wheelsoil's additions marked +)::
     /stages/<k>/      + only for a drive of several stages (``[[protocol.stages]]``, a slip ramp): attrs as
                       /summary's, one group per stage in order (``000``, ``001``, ...); /summary is the last's
     /run              + attrs: wall time, step counts, sizes (coupling.testbed_result.TestbedResult.info)
+                      (and resumed_from, frames_lost_before [s]: a run continued from a checkpoint, one carried
+                      to another machine without its earlier frames, cases.carry)
     /mesh/            nodes0 (N, 3) [m] (wheel in its start pose), triangles (T, 3), beams (B, 2)
     /frames/<k>/      attr t [s]; particles/{position, velocity (float32), radius}, wheel/{nodes,
                       + deflection (float32: node position less the wheel's best-fit rigid motion of

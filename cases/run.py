@@ -11,6 +11,13 @@
 While running, ``.result.h5.partial`` collects frames and ``.checkpoint.h5`` the latest state; a run
 killed after a checkpoint continues with ``resume=True`` (``--resume``) and ends with the same result
 as a run that was never interrupted (bit for bit on the same machine and backend).
+
+A checkpoint's metadata: ``case_hash``, ``t`` [s], ``checkpoints`` and ``frames`` (the frames the schedule has taken,
+which times the next one) and ``frames_written`` (those the partial file holds; absent in checkpoints written before
+runs could be carried: the same as ``frames``). A checkpoint carried to another machine without its partial file
+(:mod:`.carry`) has ``frames_written`` 0 and ``frames_lost_before`` [s], its time: the run resumes into a new partial
+file, and its result's ``run`` info keeps ``frames_lost_before`` (its frames start there; series and summary are
+whole).
 """
 
 from __future__ import annotations
@@ -119,13 +126,17 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     mesh = {"nodes0": nodes0, "triangles": bench.mesh.triangles, "beams": bench.mesh.beams.reshape(-1, 2)}
     frame_dt, ckpt_dt = case.output.frame_interval, case.output.checkpoint_interval
     counters = {"frames": 0, "checkpoints": 0}
-    resumed_from = None
+    resumed_from, frames_lost_before, kept_frames = None, meta.get("frames_lost_before"), None
     if ckpt_state is not None:
         counters["frames"], counters["checkpoints"] = int(meta["frames"]), int(meta["checkpoints"])
+        kept_frames = int(meta.get("frames_written", meta["frames"]))
+        if frames_lost_before is not None and kept_frames == 0 and not partial_path(result_path).is_file():
+            kept_frames = None  # carried here without its frames: a new partial file
         bench.restore_state(ckpt_state)
         resumed_from = float(bench.scene.time)
-        say(f"resuming from the checkpoint at t = {resumed_from:.3f} s ({counters['frames']} frames kept)")
-    writer = ResultWriter(result_path, attrs, mesh, resume_frames=counters["frames"] if resume else None)
+        lost = f"; its frames before t = {frames_lost_before:.3f} s were not carried" if frames_lost_before else ""
+        say(f"resuming from the checkpoint at t = {resumed_from:.3f} s ({kept_frames or 0} frames kept{lost})")
+    writer = ResultWriter(result_path, attrs, mesh, resume_frames=kept_frames)
 
     def add_frame(tb) -> None:
         nodes = tb.structure.positions()
@@ -140,8 +151,11 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
         if ckpt_dt > 0 and t >= (counters["checkpoints"] + 1) * ckpt_dt - 1e-12:
             counters["checkpoints"] = int(math.floor(t / ckpt_dt + 1e-9))
             writer.flush()
-            save_checkpoint(ckpt_path, tb.state(), {"case_hash": case_hash, "frames": counters["frames"],
-                                                    "checkpoints": counters["checkpoints"], "t": t})
+            ckpt_meta = {"case_hash": case_hash, "frames": counters["frames"], "frames_written": writer.n_frames,
+                         "checkpoints": counters["checkpoints"], "t": t}
+            if frames_lost_before is not None:
+                ckpt_meta["frames_lost_before"] = frames_lost_before
+            save_checkpoint(ckpt_path, tb.state(), ckpt_meta)
 
     try:
         with keep_cores_awake(requested_by_environment()):  # opt-in: WHEELSOIL_KEEP_CORES_AWAKE=1
@@ -155,6 +169,8 @@ def run_case(case: CaseFile, out: str | Path, *, arch: str | None = None, resume
     info = dict(result.info)
     if resumed_from is not None:
         info["resumed_from"] = resumed_from
+    if frames_lost_before is not None:
+        info["frames_lost_before"] = float(frames_lost_before)
     writer.finish(result.series, SERIES_UNITS, result.summary, info, result.stages)
     ckpt_path.unlink(missing_ok=True)
     write_run_folder(out, case, result, prov)

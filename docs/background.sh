@@ -19,6 +19,12 @@ RUNS=${1:-/work/runs}
 PY=${PYTHON:-.venv/bin/python}
 mkdir -p "$RUNS"
 export HDF5_USE_FILE_LOCKING=FALSE WHEELSOIL_CPU_THREADS=1
+# Runs carried from the machine before (docs/inflight/README.md): their checkpoints go back under RUNS first, so that
+# each job resumes them instead of starting them again; a run finished or further along here is kept as it is. Before
+# a session stops: "$PY" -m wheelsoil.cases.cli carry pack "$RUNS" --to docs/inflight --max-mb 40, and commit.
+if compgen -G "docs/inflight/*.carry.h5" > /dev/null; then
+  "$PY" -m wheelsoil.cases.cli carry unpack docs/inflight --into "$RUNS"
+fi
 running() { pgrep -f "$1" > /dev/null; }
 start() {  # start NAME PATTERN LOG COMMAND...
   local name=$1 pattern=$2 log=$3; shift 3

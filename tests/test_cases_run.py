@@ -1,6 +1,7 @@
 """One run from a case file: result layout, round trip case -> result -> case, atomic write under a kill,
 resume equal to an uninterrupted run, the XDMF sidecar, renders of frames and animations."""
 
+import json
 import signal
 import subprocess
 import sys
@@ -144,6 +145,108 @@ def test_a_killed_run_leaves_no_finished_file_and_resume_equals_the_uninterrupte
         np.testing.assert_array_equal(b.frame(k)["position"], a.frame(k)["position"])
         np.testing.assert_array_equal(b.frame(k)["wheel_nodes"], a.frame(k)["wheel_nodes"])
     assert not (out / CHECKPOINT_NAME).exists() and not partial_path(out / RESULT_NAME).exists()
+
+
+class _StopAfterCheckpoint(Exception):
+    """Raised by the test's checkpoint writer once a run has kept a checkpoint with frames before it."""
+
+
+@pytest.mark.slow  # a mini run and a bed prepared again: 1-2 min
+def test_a_run_carried_without_its_frames_ends_as_the_uninterrupted_run_on_a_bed_prepared_again(
+        reference, tmp_path, monkeypatch):
+    from wheelsoil.cases import run as run_module
+    from wheelsoil.cases.carry import CARRY_SUFFIX, pack_runs, unpack_runs
+    from wheelsoil.cases.schema import case_to_toml
+
+    case, ref_out, _ = reference
+    here = tmp_path / "here"
+    out = here / "sweep" / "cases" / case.case_hash()
+    write = run_module.save_checkpoint
+
+    def write_then_stop(path, state, meta):  # the machine goes away after the checkpoint at t = 0.2 s
+        write(path, state, meta)
+        if meta["t"] > 0.19:
+            raise _StopAfterCheckpoint
+
+    monkeypatch.setattr(run_module, "save_checkpoint", write_then_stop)
+    with pytest.raises(_StopAfterCheckpoint):
+        run_case(case, out)
+    monkeypatch.undo()
+    (out / "case.toml").write_text(case_to_toml(case))  # as a sweep's case folder holds it
+    with h5py.File(partial_path(out / RESULT_NAME), "r") as f:
+        assert len(f["frames"]) >= 3  # frames the carry leaves behind
+
+    carried = tmp_path / "carried"
+    [packed] = pack_runs(here, carried)
+    assert packed.done == "packed" and packed.carry == carried / f"{case.case_hash()}{CARRY_SUFFIX}"
+    assert packed.folder == f"sweep/cases/{case.case_hash()}"
+    assert packed.carry.stat().st_size < (out / CHECKPOINT_NAME).stat().st_size  # compressed
+
+    there = tmp_path / "there"  # the other machine: another runs folder and another bed cache
+    [unpacked] = unpack_runs(carried, there)
+    folder = there / packed.folder
+    assert unpacked.done.startswith("unpacked") and unpacked.t == pytest.approx(packed.t)
+    assert sorted(p.name for p in folder.iterdir()) == [CHECKPOINT_NAME, "case.toml"]
+    assert load_case(folder / "case.toml") == case
+    outcome = run_case(case, folder, resume=True, bed_cache=tmp_path / "bed-prepared-again")
+    assert outcome.resumed_from == pytest.approx(packed.t)
+
+    a, b = load_result(ref_out), load_result(folder)
+    for name in SERIES_UNITS:
+        np.testing.assert_array_equal(b.series[name], a.series[name], err_msg=name)
+    assert json.dumps(b.summary.to_dict(), sort_keys=True) == json.dumps(a.summary.to_dict(), sort_keys=True)
+    assert b.info["frames_lost_before"] == pytest.approx(packed.t)
+    after = a.frame_times > packed.t + 1e-12
+    np.testing.assert_array_equal(b.frame_times, a.frame_times[after])
+    for k, ref_k in enumerate(np.flatnonzero(after)):
+        np.testing.assert_array_equal(b.frame(k)["position"], a.frame(int(ref_k))["position"])
+
+    # nothing moves backwards: the finished run is kept, and packing removes the carry whose run has finished
+    assert unpack_runs(carried, there)[0].done == "kept as it is: the run has finished here"
+    assert [c.done for c in pack_runs(there, carried)] == ["removed: the run has finished here"]
+    assert not list(carried.iterdir())
+
+
+def test_carry_refuses_what_it_cannot_carry_and_never_packs_over_a_newer_carry(tmp_path):
+    from wheelsoil.cases.carry import pack_run, pack_runs, unpack_run
+    from wheelsoil.state_file import save_state
+
+    runs = tmp_path / "runs"
+    with pytest.raises(WheelsoilInputError, match="the runs folder .* does not exist"):
+        pack_runs(runs, tmp_path / "carried")
+    old, new = runs / "a", tmp_path / "elsewhere" / "a"
+    for folder, t in ((old, 1.0), (new, 2.0)):
+        folder.mkdir(parents=True)
+        save_state(folder / CHECKPOINT_NAME, {"x": np.arange(2000.0)}, {"case_hash": "c0ffee", "t": t,
+                                                                       "checkpoints": 4, "frames": 20})
+    with pytest.raises(WheelsoilInputError, match="must be > 0"):
+        pack_runs(runs, tmp_path / "carried", max_mb=0)
+    [skipped] = pack_runs(runs, tmp_path / "carried", max_mb=1e-3)
+    assert skipped.done.startswith("not packed: its checkpoint is 0 MB, over --max-mb 0.001")
+    pack_runs(new.parent, tmp_path / "carried")  # the run at t = 2 s, packed on another machine
+    [kept] = pack_runs(runs, tmp_path / "carried")  # this machine's older checkpoint does not replace it
+    assert kept.done.startswith("not packed: the carry in") and "t = 2.000 s" in kept.done
+    assert unpack_run(tmp_path / "carried" / "c0ffee.carry.h5", runs).done == "unpacked: resume it (wheelsoil run " \
+        "--resume, or its sweep)"
+    assert unpack_run(tmp_path / "carried" / "c0ffee.carry.h5", runs).done == \
+        "kept as it is: its checkpoint here is at t = 2.000 s"
+    (old / RESULT_NAME).write_text("finished")
+    with pytest.raises(WheelsoilInputError, match="holds a finished run"):
+        pack_run(old, runs, tmp_path / "carried")
+    (runs / "b").mkdir()
+    with pytest.raises(WheelsoilInputError, match="has no checkpoint"):
+        pack_run(runs / "b", runs, tmp_path / "carried")
+    save_state(tmp_path / "stray.carry.h5", {}, {"case_hash": "c0ffee", "t": 1.0, "checkpoints": 1, "frames": 1,
+                                                  "folder": "../../outside"})
+    with pytest.raises(WheelsoilInputError, match="outside the runs folder"):
+        unpack_run(tmp_path / "stray.carry.h5", runs)
+
+
+def test_carry_command_says_what_it_did(tmp_path, capsys):
+    assert main(["carry", "pack", str(tmp_path), "--to", str(tmp_path / "c")]) == 0
+    assert "no unfinished run with a checkpoint under" in capsys.readouterr().out
+    assert main(["carry", "unpack", str(tmp_path / "missing"), "--into", str(tmp_path)]) == EXIT_INPUT
+    assert "wheelsoil carry: error: the carry folder" in capsys.readouterr().err
 
 
 def test_resume_without_a_checkpoint_is_refused(tmp_path, capsys):

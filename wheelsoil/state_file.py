@@ -22,12 +22,20 @@ def attr_value(value):
     return value
 
 
-def _write_tree(group: h5py.Group, tree: dict) -> None:
+#: Arrays smaller than this many elements are stored without a filter (a compressed dataset is chunked, and a
+#: chunk's overhead outweighs what a few values would save).
+COMPRESS_FROM = 1024
+
+
+def _write_tree(group: h5py.Group, tree: dict, compression: str | None = None) -> None:
     for key, value in tree.items():
         if isinstance(value, dict):
-            _write_tree(group.create_group(key), value)
+            _write_tree(group.create_group(key), value, compression)
         elif isinstance(value, np.ndarray):
-            group.create_dataset(key, data=value)
+            if compression is not None and value.size >= COMPRESS_FROM:
+                group.create_dataset(key, data=value, compression=compression, shuffle=True)
+            else:
+                group.create_dataset(key, data=value)
         else:
             group.attrs[key] = value
 
@@ -39,11 +47,13 @@ def _read_tree(group: h5py.Group) -> dict:
     return out
 
 
-def save_state(path: str | Path, state: dict, meta: dict) -> None:
-    """Write ``state`` (nested dict of arrays and scalars) and ``meta`` (scalars) to ``path`` atomically."""
+def save_state(path: str | Path, state: dict, meta: dict, *, compression: str | None = None) -> None:
+    """Write ``state`` (nested dict of arrays and scalars) and ``meta`` (scalars) to ``path`` atomically;
+    ``compression``: an HDF5 filter for the larger arrays (``"gzip"``, with byte shuffling; default none: a running
+    checkpoint is written often and read back whole, a carried one, :mod:`wheelsoil.cases.carry`, travels)."""
     with atomic_output(Path(path)) as tmp:
         with h5py.File(tmp, "w") as f:
-            _write_tree(f.create_group("state"), state)
+            _write_tree(f.create_group("state"), state, compression)
             for key, value in meta.items():
                 f.attrs[key] = value
 
@@ -54,3 +64,9 @@ def load_state(path: str | Path) -> tuple[dict, dict]:
         state = _read_tree(f["state"])
         meta = {k: attr_value(v) for k, v in f.attrs.items()}
     return state, meta
+
+
+def load_meta(path: str | Path) -> dict:
+    """The metadata of a file :func:`save_state` wrote, without reading its arrays."""
+    with h5py.File(path, "r") as f:
+        return {k: attr_value(v) for k, v in f.attrs.items()}

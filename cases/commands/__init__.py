@@ -4,5 +4,5 @@ subparsers ``sub`` and sets its ``func``, a function of the parsed arguments ret
 builds the parser from :data:`COMMANDS` and maps errors to exit codes."""
 
 #: The command modules, in the order ``wheelsoil --help`` lists them.
-COMMANDS = ("run", "case", "batch", "replicate", "convergence", "prepare_bed", "render", "bench", "wheel", "validate",
-            "soil_lab")
+COMMANDS = ("run", "case", "batch", "replicate", "convergence", "carry", "prepare_bed", "render", "bench", "wheel",
+            "validate", "soil_lab")

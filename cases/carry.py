@@ -1,0 +1,168 @@
+"""Unfinished runs carried to another machine without their frames.
+
+A run's checkpoint (``.checkpoint.h5``, :mod:`.run`) holds its whole state and its time series, so a checkpoint
+alone is enough to continue it; its partial result holds the frames, which are most of an unfinished run's bytes (a
+frame of the CMU twin's 21,500 spheres is 0.8 MB, 400 of them in its 20 s drive, where its checkpoint is about
+0.8 kB a sphere). :func:`pack_runs` packs the checkpoint of every unfinished run under a folder, compressed, into one
+file each (``<case hash>.carry.h5``, with the run folder's path relative to that folder and its ``case.toml``), and
+:func:`unpack_runs` puts them back as checkpoints under a runs folder on the other machine, where ``wheelsoil run
+--resume`` (and a sweep or convergence study, which resume any case folder with a checkpoint) continues each run.
+
+What the carried run ends with: the series and summary of a run never moved, to the bit where the bed prepared on
+the other machine is the same (the DEM's force pass is a gather and the thread count does not change a result, so a
+bed prepared from the same case with the same code on the same backend is: ``tests/test_cases_run.py`` resumes a
+carried run on a bed prepared again); its result holds only the frames from the carry on and says so in its run info
+(``frames_lost_before`` [s]). Packing never moves a run backwards: a checkpoint is unpacked only into a folder with no
+finished result and no checkpoint as new or newer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from wheelsoil.errors import WheelsoilInputError
+from wheelsoil.state_file import load_meta, load_state, save_state
+
+from .results import partial_path
+from .run import CHECKPOINT_NAME, RESULT_NAME
+
+#: A carried run's file name: its case hash and this suffix.
+CARRY_SUFFIX = ".carry.h5"
+#: The checkpoint metadata a carry keeps (:mod:`.run`'s module docstring).
+CHECKPOINT_META = ("case_hash", "t", "checkpoints", "frames")
+#: Checkpoints larger than this on disk are not packed by default [MB] (a carry is meant to travel in a repository;
+#: the seed-004 full-scale bed of 193,000 spheres makes checkpoints of about 150 MB).
+DEFAULT_MAX_MB = 60.0
+
+
+@dataclass(frozen=True)
+class Carried:
+    """One run, packed or unpacked: its ``folder`` (relative to the runs folder), case hash, simulated time ``t`` [s]
+    of its checkpoint, the carry file, and what was done (``"packed"``, ``"unpacked"``, or why it was skipped)."""
+
+    folder: str
+    case_hash: str
+    t: float
+    carry: Path
+    done: str
+
+    def line(self) -> str:
+        return f"{self.folder} (case {self.case_hash}, t = {self.t:.3f} s): {self.done}"
+
+
+def carry_path(dest: Path, case_hash: str) -> Path:
+    """Where the carry of case ``case_hash`` lies in ``dest``."""
+    return Path(dest) / f"{case_hash}{CARRY_SUFFIX}"
+
+
+def unfinished_runs(runs: Path) -> list[Path]:
+    """The run folders under ``runs`` (itself included) with a checkpoint and no finished result, sorted."""
+    runs = Path(runs)
+    found = [p.parent for p in runs.rglob(CHECKPOINT_NAME)] if runs.is_dir() else []
+    return sorted(p for p in found if not (p / RESULT_NAME).is_file())
+
+
+def pack_run(folder: Path, runs: Path, dest: Path) -> Carried:
+    """Pack the checkpoint of the unfinished run in ``folder`` (under ``runs``) into ``dest``, compressed."""
+    folder, runs = Path(folder), Path(runs)
+    ckpt = folder / CHECKPOINT_NAME
+    if (folder / RESULT_NAME).is_file():
+        raise WheelsoilInputError(f"{folder} holds a finished run ({RESULT_NAME}): nothing to carry")
+    if not ckpt.is_file():
+        raise WheelsoilInputError(f"{folder} has no checkpoint ({CHECKPOINT_NAME}): nothing to carry")
+    state, meta = load_state(ckpt)
+    missing = [k for k in CHECKPOINT_META if k not in meta]
+    if missing:
+        raise WheelsoilInputError(f"the checkpoint {ckpt} lacks {', '.join(missing)}: not a run's checkpoint")
+    relative = folder.resolve().relative_to(runs.resolve()).as_posix()
+    case_toml = (folder / "case.toml").read_text() if (folder / "case.toml").is_file() else ""
+    out = carry_path(dest, meta["case_hash"])
+    out.parent.mkdir(parents=True, exist_ok=True)
+    save_state(out, state, {**{k: meta[k] for k in CHECKPOINT_META}, "folder": relative, "case_toml": case_toml},
+               compression="gzip")
+    return Carried(relative, meta["case_hash"], float(meta["t"]), out, "packed")
+
+
+def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list[Carried]:
+    """Pack every unfinished run under ``runs`` (:func:`unfinished_runs`) into ``dest``. Skipped, and said: a
+    checkpoint over ``max_mb``, and one older than the carry of its case already in ``dest`` (a carry not unpacked
+    here: packing never moves a run backwards). Carries in ``dest`` of runs that have finished under ``runs`` are
+    removed (their results are here). Refuses two unfinished runs of one case under ``runs`` (their carries would
+    share a name) before packing any."""
+    runs, dest = Path(runs), Path(dest)
+    if not runs.is_dir():
+        raise WheelsoilInputError(f"the runs folder {runs} does not exist")
+    if max_mb <= 0:
+        raise WheelsoilInputError(f"--max-mb {max_mb} must be > 0")
+    folders = unfinished_runs(runs)
+    by_case: dict[str, list[Path]] = {}
+    metas = {}
+    for folder in folders:
+        meta = load_meta(folder / CHECKPOINT_NAME)
+        metas[folder] = meta
+        by_case.setdefault(str(meta.get("case_hash")), []).append(folder)
+    twice = {h: fs for h, fs in by_case.items() if len(fs) > 1}
+    if twice:
+        h, fs = next(iter(twice.items()))
+        raise WheelsoilInputError(f"two unfinished runs of case {h} under {runs} ({', '.join(map(str, fs))}): "
+                                  "pack each into its own folder")
+    done = []
+    for folder in folders:
+        meta = metas[folder]
+        size_mb = (folder / CHECKPOINT_NAME).stat().st_size / 1e6
+        relative = folder.resolve().relative_to(runs.resolve()).as_posix()
+        carry = carry_path(dest, meta["case_hash"])
+        skipped = lambda why: Carried(relative, str(meta["case_hash"]), float(meta["t"]), carry, why)  # noqa: E731
+        carried_t = float(load_meta(carry).get("t", -1.0)) if carry.is_file() else -1.0
+        if size_mb > max_mb:
+            done.append(skipped(f"not packed: its checkpoint is {size_mb:.0f} MB, over --max-mb {max_mb:g}"))
+        elif carried_t > float(meta["t"]):
+            done.append(skipped(f"not packed: the carry in {dest} is newer (t = {carried_t:.3f} s; unpack it first)"))
+        else:
+            done.append(pack_run(folder, runs, dest))
+    for carry in sorted(dest.glob(f"*{CARRY_SUFFIX}")) if dest.is_dir() else []:
+        meta = load_meta(carry)
+        here = runs / str(meta.get("folder", ""))
+        if (here / RESULT_NAME).is_file():
+            carry.unlink()
+            done.append(Carried(str(meta["folder"]), str(meta["case_hash"]), float(meta["t"]), carry,
+                                "removed: the run has finished here"))
+    return done
+
+
+def unpack_run(carry: Path, runs: Path) -> Carried:
+    """Put the carried checkpoint ``carry`` back under ``runs`` (its folder as packed), unless that folder holds a
+    finished run or a checkpoint as new or newer; the folder's partial result, if any, is removed (its frames do not
+    belong to the carried state)."""
+    carry, runs = Path(carry), Path(runs)
+    state, meta = load_state(carry)
+    missing = [k for k in CHECKPOINT_META + ("folder",) if k not in meta]
+    if missing:
+        raise WheelsoilInputError(f"{carry} lacks {', '.join(missing)}: not a carried run (wheelsoil carry pack)")
+    relative, t = str(meta["folder"]), float(meta["t"])
+    folder = (runs / relative).resolve()
+    if runs.resolve() not in (folder, *folder.parents):
+        raise WheelsoilInputError(f"{carry} names the folder {relative!r}, outside the runs folder {runs}")
+    said = lambda done: Carried(relative, str(meta["case_hash"]), t, carry, done)  # noqa: E731
+    if (folder / RESULT_NAME).is_file():
+        return said("kept as it is: the run has finished here")
+    if (folder / CHECKPOINT_NAME).is_file():
+        here = float(load_meta(folder / CHECKPOINT_NAME).get("t", -1.0))
+        if here >= t:
+            return said(f"kept as it is: its checkpoint here is at t = {here:.3f} s")
+    folder.mkdir(parents=True, exist_ok=True)
+    if meta.get("case_toml") and not (folder / "case.toml").is_file():
+        (folder / "case.toml").write_text(str(meta["case_toml"]))
+    partial_path(folder / RESULT_NAME).unlink(missing_ok=True)
+    save_state(folder / CHECKPOINT_NAME, state, {**{k: meta[k] for k in CHECKPOINT_META}, "frames_written": 0,
+                                                 "frames_lost_before": t})
+    return said("unpacked: resume it (wheelsoil run --resume, or its sweep)")
+
+
+def unpack_runs(dest: Path, runs: Path) -> list[Carried]:
+    """:func:`unpack_run` of every carry in ``dest`` into ``runs``."""
+    dest = Path(dest)
+    if not dest.is_dir():
+        raise WheelsoilInputError(f"the carry folder {dest} does not exist")
+    return [unpack_run(c, runs) for c in sorted(dest.glob(f"*{CARRY_SUFFIX}"))]
