@@ -280,16 +280,25 @@ def markdown(report: dict) -> str:
     sc = report["scale"]
     if _section(lines, "Particle scale of the 100 mm plate (wide box)", sc):
         lines += [f"Scales run: {', '.join(f'×{x:g}' for x in sc['scales_run'])} (seed 0), with the ×1 replicas "
-                  f"(seeds {', '.join(str(r['seed']) for r in sc['replica_points'])}) as further points.", "",
-                  "| sinkage [mm] | points | p0 [kPa] | the lab's particles [kPa] | scale error | converged (10 %, 2 SE) |",
-                  "|---|---|---|---|---|---|"]
+                  f"(seeds {', '.join(str(r['seed']) for r in sc['replica_points'])}) as further points. The scale "
+                  "error of a size is the line's change from p0 there, relative to p0 (×0.8 is the CMU twin's "
+                  "particles); converged where it lies within 10 % at two standard errors. The quadratic's p0 "
+                  "through the sizes' means (three sizes) shows the line's curvature.", "",
+                  "| sinkage [mm] | points | p0 [kPa] | the lab's particles [kPa] | scale error ×1 | converged ×1 | "
+                  "scale error ×0.8 | converged ×0.8 | p0, quadratic [kPa] |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for e in sc["extrapolation"]:
             if "p0_Pa" not in e:
-                lines.append(f"| {1e3 * e['sinkage_m']:g} | {e['points']} | – | – | – | too few points |")
+                lines.append(f"| {1e3 * e['sinkage_m']:g} | {e['points']} | – | – | – | too few points | – | – | – |")
                 continue
+            twin = e.get("by_scale", {}).get("0.8")
+            twin_cells = (f"{100 * twin['scale_error']:+.0f} ± {100 * twin['scale_error_se']:.0f} % | "
+                          f"{'yes' if twin['converged'] else 'no'}") if twin else "– | –"
+            quad = f"{1e-3 * e['p0_quadratic_Pa']:.1f}" if "p0_quadratic_Pa" in e else "–"
             lines.append(f"| {1e3 * e['sinkage_m']:g} | {e['points']} | {1e-3 * e['p0_Pa']:.1f} ± "
                          f"{1e-3 * e['p0_se_Pa']:.1f} | {1e-3 * e['default_Pa']:.1f} | {100 * e['scale_error']:+.0f} ± "
-                         f"{100 * e['scale_error_se']:.0f} % | {'yes' if e['converged'] else 'no'} |")
+                         f"{100 * e['scale_error_se']:.0f} % | {'yes' if e['converged'] else 'no'} | {twin_cells} | "
+                         f"{quad} |")
         lines.append("")
     return "\n".join(lines)
 

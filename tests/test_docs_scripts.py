@@ -6,6 +6,7 @@ import ast
 import importlib
 import importlib.util
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -478,7 +479,15 @@ def test_the_choice_checks_summary_reads_every_check_by_its_rule(tmp_path, monke
     extrapolation = report["scale"]["extrapolation"]
     assert [e["points"] for e in extrapolation] == [5] * 4
     assert all(e["p0_Pa"] == pytest.approx(p0, rel=1e-9) for e in extrapolation)
+    for e in extrapolation:  # the line's error at each size run: slope d / p0 (x0.8: the twin's particles)
+        assert sorted(e["by_scale"]) == ["0.64", "0.8", "1"]
+        for x, d in (("1", 0.008), ("0.8", 0.0064), ("0.64", 0.00512)):
+            assert e["by_scale"][x]["scale_error"] == pytest.approx(slope * d / p0, rel=1e-9)
+        assert e["by_scale"]["0.64"]["converged"] is False  # +51 %: not within 10 %
+        assert e["p0_quadratic_Pa"] == pytest.approx(p0, rel=1e-6)
     text = (out / "summary.md").read_text()
+    # the 5 mm row: p0 10 kPa, the lab's particles 18 kPa, +80 % at x1 and +64 % at x0.8, the quadratic's p0 10 kPa
+    assert re.search(r"\| 5 \| 5 \| 10\.0 ± [\d.]+ \| 18\.0 \| \+80 ± \d+ % \| no \| \+64 ± \d+ % \| no \| 10\.0 \|", text)
     assert "Not quasi-static" in text and "not run yet" in text
 
 
