@@ -9,9 +9,11 @@ from wheelsoil.granular import BedSpec, Material, PairProperties
 from wheelsoil.soillab import PlateSpec, ShearSpec, plate_test, poured_bed_test, shear_test
 from wheelsoil.soillab.penetration import resting_plate
 
-#: The slow tier: about 75 s of small DEM tests on 2 cores, which kept the fast tier over its 5 minutes (the soil
-#: lab's plain parts, fits and errors stay fast: tests/test_soillab_plain.py).
-pytestmark = pytest.mark.slow
+#: The two checks whose answer is known -- the plate at rest carries its weight, the shear cap holds the imposed
+#: stress -- run in the fast tier on one small bed (about 25 s on 2 cores with its preparation); the rest of this
+#: file's small DEM tests (about 50 s) in the slow tier, with the lab's plain parts, fits and errors fast in
+#: tests/test_soillab_plain.py.
+slow = pytest.mark.slow
 
 SOIL = Material("test particles", youngs_modulus=5e7, poisson_ratio=0.3, density=2300.0)
 PAIR = PairProperties(restitution=0.5, static_friction=0.5, rolling_friction=0.1)
@@ -24,7 +26,7 @@ def small_bed(seed=0, **kw):
     return BedSpec(**values)
 
 
-@pytest.mark.parametrize("mass", [0.5, 2.0])
+@pytest.mark.parametrize("mass", [pytest.param(0.5, marks=slow), 2.0])
 def test_plate_at_rest_carries_its_own_weight(bed_cache, mass):
     """Laid on the bed and left under gravity, the soil's force on the plate over the last quarter of a 0.25 s rest
     equals its weight (to 2 %: what the rest's last motion leaves; the plate comes to rest within about 0.1 s)."""
@@ -33,6 +35,7 @@ def test_plate_at_rest_carries_its_own_weight(bed_cache, mass):
     assert rest.settlement > 0 and abs(rest.final_speed) < 0.01
 
 
+@slow
 def test_plate_force_starts_at_zero_and_rises(bed_cache):
     spec = PlateSpec(diameter=0.05, speed=0.1, max_sinkage=0.008, sample_interval=0.001)
     result = plate_test(small_bed(), spec, cache_dir=bed_cache)
@@ -49,6 +52,7 @@ def test_plate_force_starts_at_zero_and_rises(bed_cache):
     assert 0.5 < result.packing_fraction < 0.65
 
 
+@slow
 def test_an_interrupted_plate_test_continues_to_the_same_curve(bed_cache, tmp_path, monkeypatch):
     """A plate test killed after its second checkpoint and run again continues from it to the curve, bit for bit, of
     the same test run through (both keep a state every 2 samples); the finished test leaves no checkpoint."""
@@ -85,6 +89,7 @@ def test_an_interrupted_plate_test_continues_to_the_same_curve(bed_cache, tmp_pa
         plate_test(small_bed(), spec, cache_dir=bed_cache, checkpoint=tmp_path / "c.h5", checkpoint_every=2)
 
 
+@slow
 def test_poured_bed_over_seeds(bed_cache):
     """Bulk density = packing fraction x particle density, per seed; other seeds give other packings."""
     beds = poured_bed_test(small_bed(), seeds=(0, 1), cache_dir=bed_cache)
