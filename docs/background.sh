@@ -21,7 +21,7 @@ mkdir -p "$RUNS"
 export HDF5_USE_FILE_LOCKING=FALSE WHEELSOIL_CPU_THREADS=1
 # Runs carried from the machine before (docs/inflight/README.md): their checkpoints go back under RUNS first, so that
 # each job resumes them instead of starting them again; a run finished or further along here is kept as it is. Before
-# a session stops: "$PY" -m wheelsoil.cases.cli carry pack "$RUNS" --to docs/inflight --max-mb 40, and commit.
+# a session stops: bash docs/inflight/pack.sh "$RUNS", and commit docs/inflight.
 if compgen -G "docs/inflight/*.carry.h5" > /dev/null; then
   "$PY" -m wheelsoil.cases.cli carry unpack docs/inflight --into "$RUNS"
 fi
