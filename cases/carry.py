@@ -100,6 +100,10 @@ def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list
     metas = {}
     for folder in folders:
         meta = load_meta(folder / CHECKPOINT_NAME)
+        missing = [k for k in CHECKPOINT_META if k not in meta]
+        if missing:
+            raise WheelsoilInputError(f"the checkpoint {folder / CHECKPOINT_NAME} lacks {', '.join(missing)}: not a "
+                                      "run's checkpoint (wheelsoil run writes one)")
         metas[folder] = meta
         by_case.setdefault(str(meta.get("case_hash")), []).append(folder)
     twice = {h: fs for h, fs in by_case.items() if len(fs) > 1}

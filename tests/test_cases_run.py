@@ -236,6 +236,9 @@ def test_carry_refuses_what_it_cannot_carry_and_never_packs_over_a_newer_carry(t
     (runs / "b").mkdir()
     with pytest.raises(WheelsoilInputError, match="has no checkpoint"):
         pack_run(runs / "b", runs, tmp_path / "carried")
+    save_state(runs / "b" / CHECKPOINT_NAME, {}, {"samples": 10, "t": 0.2})  # a soil-lab press's, say
+    with pytest.raises(WheelsoilInputError, match="lacks case_hash, checkpoints, frames: not a run's checkpoint"):
+        pack_runs(runs, tmp_path / "carried")
     save_state(tmp_path / "stray.carry.h5", {}, {"case_hash": "c0ffee", "t": 1.0, "checkpoints": 1, "frames": 1,
                                                   "folder": "../../outside"})
     with pytest.raises(WheelsoilInputError, match="outside the runs folder"):
