@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The long campaigns that run in the background across sessions (issues 33, 34, 35), each resumable: this script
+# The long campaigns that run in the background across sessions (issues 34, 35), each resumable: this script
 # starts those not running, with the settings they share the machine's two cores under. Run it from the repository
 # root at the start of a session (a fresh machine keeps the repository, not RUNS):
 #   bash docs/background.sh [RUNS]        # RUNS: the runs folder outside the repository (default /work/runs)
@@ -34,14 +34,9 @@ start() {  # start NAME PATTERN LOG COMMAND...
 }
 start "CMU twin queue (issue 34)" "cmu_twin_queue.py" "$RUNS/cmu_queue.log" \
   "$PY" docs/cmu_twin_queue.py --runs "$RUNS" --queue docs/cmu-twin/queue.json
-# The calibration's last candidates, then (in the same slot, once all ten have finished) the checks owed on its choice.
-start "wide-box calibration, then its choice's checks (issue 33)" \
-  "soillab_calibration.py run --design epsd-box|choice-checks/run.sh" docs/soillab/calibration-epsd-box-run.log \
-  bash -c '"$0" docs/soillab_calibration.py run --design epsd-box --box 0.6 0.6 0.12 \
-    --reuse docs/soillab/calibration-epsd docs/soillab/calibration-epsd-surface \
-    --out docs/soillab/calibration-epsd-box --resume --cache "$1/lab-cache" \
-    && CACHE="$1/lab-cache" PYTHON="$0" bash docs/soillab/choice-checks/run.sh >> docs/soillab/choice-checks/run.log 2>&1' \
-  "$PY" "$RUNS"
+# The soil lab's calibration and the checks on its choice (issue 33) finished on 2026-12-07 (the x0.64 plate last;
+# docs/soillab/choice-checks/summary.md): rerun them with CACHE=RUNS/lab-cache bash docs/soillab/choice-checks/run.sh
+# (every finished step is kept).
 # The five-gravity campaigns and the validation examples' leave-one-angle-out runs under the accepted rule finished on
 # 2026-11-29 (docs/validation/campaigns.md, docs/validation/README.md); their core now runs issue 35's sweeps, each
 # with its comparison fixed before any run: seed 004's own conditions at smoke scale (54 cases of 4-10 min;
