@@ -102,11 +102,17 @@ def cmd_run(args) -> int:
     if unknown:
         raise SystemExit(f"--variants {sorted(unknown)}: not variants of the study ({[v.name for v in VARIANTS]})")
     every = {v.name: variant_runs(v, runs, seeds) for v in chosen}  # every case validated before any runs
+    record_path = Path(args.recorded)
+    recorded = json.loads(record_path.read_text()) if record_path.is_file() else {}
     for k, seed in enumerate(seeds):  # every variant's first seed before any second: the terms first, the spread after
         for v in chosen:
             case = every[v.name][k]
             if case.finished:
                 print(f"{v.name}, seed {seed}: finished before ({case.folder})", flush=True)
+                continue
+            if recorded.get(v.name, {}).get(str(seed), {}).get("case_hash") == case.folder.name:
+                # finished on a machine before this one: its record is what lasts, so it is not run twice
+                print(f"{v.name}, seed {seed}: recorded in {record_path} (its files are not here); skipped", flush=True)
                 continue
             case.folder.parent.mkdir(parents=True, exist_ok=True)
             with open(case.folder.parent / f"{case.folder.name}.lock", "w") as lock:
@@ -324,6 +330,8 @@ def main(argv=None) -> int:
     r.add_argument("--runs", required=True)
     r.add_argument("--seeds", nargs="+", default=["0", "1"])
     r.add_argument("--variants", nargs="+", help="run only these variants (default: all, in the study's order)")
+    r.add_argument("--recorded", default=str(ROOT / "docs" / "gravity-terms" / "runs.json"),
+                   help="the study's record of finished runs (the report writes it): their cases are not run again")
     r.set_defaults(func=cmd_run)
     q = sub.add_parser("report", help="the terms table from the finished runs and the stored replicas")
     q.add_argument("--runs", required=True)

@@ -538,6 +538,25 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path)
     assert (tmp_path / "terms.png").stat().st_size > 10_000
 
 
+def test_the_gravity_terms_do_not_run_again_a_case_recorded_in_the_repository(tmp_path, monkeypatch, capsys):
+    """A fresh machine has none of the runs' files: ``run`` skips the cases runs.json records (same case hash) and
+    runs the others (run_sweep replaced by a recorder here: no DEM)."""
+    from wheelsoil.cases import sweep
+
+    gt = _load("gravity_terms")
+    variant = gt.VARIANTS[0]
+    seed1, seed2 = gt.variant_runs(variant, tmp_path, [1, 2])
+    record = tmp_path / "runs.json"
+    record.write_text(json.dumps({variant.name: {"1": {"case_hash": seed1.folder.name},
+                                                 "2": {"case_hash": "0" * 16}}}))  # seed 2's record: another case
+    ran = []
+    monkeypatch.setattr(sweep, "run_sweep", lambda s, workers=None: ran.append(s.cases[0].folder.name))
+    assert gt.main(["run", "--runs", str(tmp_path), "--seeds", "1", "2", "--variants", variant.name,
+                    "--recorded", str(record)]) == 0
+    assert ran == [seed2.folder.name]
+    assert f"{variant.name}, seed 1: recorded in {record} (its files are not here); skipped" in capsys.readouterr().out
+
+
 def test_the_gravity_terms_keep_a_run_recorded_in_the_repository_when_its_files_are_gone(tmp_path):
     gt = _load("gravity_terms")
     variant = gt.VARIANTS[0]
