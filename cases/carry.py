@@ -51,6 +51,13 @@ class Carried:
         return f"{self.folder} (case {self.case_hash}, t = {self.t:.3f} s): {self.done}"
 
 
+def _check_meta(meta: dict, path: Path, keys=CHECKPOINT_META, what: str = "not a run's checkpoint") -> None:
+    """Refuse the state file at ``path`` when its metadata lacks any of ``keys``, naming them."""
+    missing = [k for k in keys if k not in meta]
+    if missing:
+        raise WheelsoilInputError(f"{path} lacks {', '.join(missing)}: {what}")
+
+
 def carry_path(dest: Path, case_hash: str) -> Path:
     """Where the carry of case ``case_hash`` lies in ``dest``."""
     return Path(dest) / f"{case_hash}{CARRY_SUFFIX}"
@@ -72,9 +79,7 @@ def pack_run(folder: Path, runs: Path, dest: Path) -> Carried:
     if not ckpt.is_file():
         raise WheelsoilInputError(f"{folder} has no checkpoint ({CHECKPOINT_NAME}): nothing to carry")
     state, meta = load_state(ckpt)
-    missing = [k for k in CHECKPOINT_META if k not in meta]
-    if missing:
-        raise WheelsoilInputError(f"the checkpoint {ckpt} lacks {', '.join(missing)}: not a run's checkpoint")
+    _check_meta(meta, ckpt)
     relative = folder.resolve().relative_to(runs.resolve()).as_posix()
     case_toml = (folder / "case.toml").read_text() if (folder / "case.toml").is_file() else ""
     out = carry_path(dest, meta["case_hash"])
@@ -100,10 +105,7 @@ def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list
     metas = {}
     for folder in folders:
         meta = load_meta(folder / CHECKPOINT_NAME)
-        missing = [k for k in CHECKPOINT_META if k not in meta]
-        if missing:
-            raise WheelsoilInputError(f"the checkpoint {folder / CHECKPOINT_NAME} lacks {', '.join(missing)}: not a "
-                                      "run's checkpoint (wheelsoil run writes one)")
+        _check_meta(meta, folder / CHECKPOINT_NAME)
         metas[folder] = meta
         by_case.setdefault(str(meta.get("case_hash")), []).append(folder)
     twice = {h: fs for h, fs in by_case.items() if len(fs) > 1}
@@ -141,9 +143,7 @@ def unpack_run(carry: Path, runs: Path) -> Carried:
     belong to the carried state)."""
     carry, runs = Path(carry), Path(runs)
     state, meta = load_state(carry)
-    missing = [k for k in CHECKPOINT_META + ("folder",) if k not in meta]
-    if missing:
-        raise WheelsoilInputError(f"{carry} lacks {', '.join(missing)}: not a carried run (wheelsoil carry pack)")
+    _check_meta(meta, carry, CHECKPOINT_META + ("folder",), "not a carried run (wheelsoil carry pack)")
     relative, t = str(meta["folder"]), float(meta["t"])
     folder = (runs / relative).resolve()
     if runs.resolve() not in (folder, *folder.parents):

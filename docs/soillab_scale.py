@@ -131,12 +131,13 @@ def extrapolate(rows: list[dict]) -> list[dict]:
         entry.update(p0_Pa=fit.value, p0_se_Pa=fit.value_se, slope_Pa_per_m=fit.slope, dof=fit.dof,
                      default_Pa=fit.value + fit.change(d_default)[0], scale_error=error, scale_error_se=error_se,
                      converged=fit.converged(d_default, TOLERANCE))
-        # the line's error at each size run (x0.8 is the CMU twin's particles), with its standard error and verdict
-        entry["by_scale"] = {f"{x / d_default:.3g}": {"scale_error": fit.relative_change(x)[0],
-                                                      "scale_error_se": fit.relative_change(x)[1],
-                                                      "converged": fit.converged(x, TOLERANCE)}
-                             for x in sorted(np.unique(d[ok]), reverse=True)}
         sizes = np.unique(d[ok])
+        # the line's error at each size run (x0.8 is the CMU twin's particles), with its standard error and verdict
+        entry["by_scale"] = {}
+        for x in sizes[::-1]:
+            change, change_se = fit.relative_change(x)
+            entry["by_scale"][f"{x / d_default:.3g}"] = {"scale_error": change, "scale_error_se": change_se,
+                                                         "converged": fit.converged(x, TOLERANCE)}
         if sizes.size >= 3:
             means = [float(np.mean(p[ok][d[ok] == x])) for x in sizes]
             entry["p0_quadratic_Pa"] = float(np.polyfit(sizes, means, 2)[-1])
