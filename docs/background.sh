@@ -44,14 +44,17 @@ start "CMU twin queue (issue 34)" "cmu_twin_queue.py" "$RUNS/cmu_queue.log" \
 # docs/sweeps/seed001-flexible-rigid/README.md). Finished cases are kept and a killed one resumes from its checkpoint;
 # when cases finish, their tables are written into those folders (the commands are in their READMEs).
 # First in that slot since 2026-11-30: the gravity terms (docs/gravity-terms/README.md; nine smoke runs of 15-60 min,
-# each variant's seeds 0, 1, 2 in turn; its log $RUNS/gravity-terms.log), then the two seed-004 full-scale cases the
-# issue asks for (193,000 particles; by the cost estimate 0.4-3 h each alone on 2 cores, several times that beside
-# the other jobs; resumable from their checkpoints), then the smoke-scale sweeps.
-start "issue 35's sweeps: gravity-terms, seed004-full-scale, seed004-like, then seed001-flexible-rigid" \
+# each variant's seeds 0, 1, 2 in turn; its log $RUNS/gravity-terms.log), then the smoke-scale sweeps, and last the
+# two seed-004 full-scale cases the issue asks for (193,000 particles; by the cost estimate 0.4-3 h each alone on 2
+# cores, several times that beside the twin). Since 2026-12-07 the full-scale cases come last: their checkpoints
+# (about 150 MB) are too large to carry between machines (docs/inflight), so beside the twin they are lost at each
+# session's end, while a smoke case's checkpoint is carried; they run in a session that gives them both cores:
+#   .venv/bin/python -m wheelsoil.cases.cli batch seed004-full-scale --out RUNS/seed004-full-scale --workers 1
+start "issue 35's sweeps: gravity-terms, seed004-like, seed001-flexible-rigid, then seed004-full-scale" \
   "gravity_terms.py run|batch seed004-full-scale|batch seed004-like|batch seed001-flexible-rigid" \
   "$RUNS/issue35-sweeps.log" \
   bash -c '"$0" docs/gravity_terms.py run --runs "$1" --seeds 0 1 2 >> "$1/gravity-terms.log" 2>&1; \
-    "$0" -m wheelsoil.cases.cli batch seed004-full-scale --out "$1/seed004-full-scale" --workers 1; \
     "$0" -m wheelsoil.cases.cli batch seed004-like --out "$1/seed004-like" --workers 1; \
-    "$0" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$1/seed001-flexible-rigid" --workers 1' \
+    "$0" -m wheelsoil.cases.cli batch seed001-flexible-rigid --out "$1/seed001-flexible-rigid" --workers 1; \
+    "$0" -m wheelsoil.cases.cli batch seed004-full-scale --out "$1/seed004-full-scale" --workers 1' \
   "$PY" "$RUNS"

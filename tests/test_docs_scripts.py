@@ -529,6 +529,12 @@ def test_the_gravity_terms_name_a_step_only_beyond_two_standard_errors(tmp_path)
     assert steps["all of them: 1/6 g at equal mass"]["named"]
     assert steps["1/6 g at equal mass, rigid wheel (the wheel's term removed)"]["change"] == pytest.approx(-0.01)
     assert result["steps"][0]["lateral_force"]["change"] == pytest.approx(0.0)
+    # the diagnostic steps of a condition not run yet say nothing; once it has runs, they compare it both ways
+    assert steps["diagnostic: the 1g case at the similar case's step"] == {"change": None, "se": None, "named": None}
+    with_step = gt.analyse(dict(conditions, **{"earth-step": condition("earth-step", [0.33, 0.33])}))
+    diag = {s["term"]: s["drawbar_pull"] for s in with_step["steps"]}
+    assert diag["diagnostic: the 1g case at the similar case's step"]["change"] == pytest.approx(0.33 - 0.31)
+    assert diag["diagnostic: the similarity check at the same step (must be 0)"]["change"] == pytest.approx(0.31 - 0.33)
     unsteady = ({"seed": 4, "window": [1.0, 2.0], "reasons": ["drawbar_pull drifts"], **{q: 0.25 for q in qs}},)
     empty = dict(conditions, froude=gt.Condition("froude", [], "test", unsteady))
     assert gt.analyse(empty)["steps"][0]["drawbar_pull"] == {"change": None, "se": None, "named": None}
