@@ -76,6 +76,7 @@ from wheelsoil.taichi_types import vec3
 
 from . import candidate_kernels as ck
 from . import kernels as k
+from .node_speed import require_node_speed, shortest_edge
 from .surface import ContactSurface
 from .surface_arrays import SurfaceArrays
 
@@ -120,6 +121,17 @@ SPHERE_SKINS = 4.0
 CLEARANCE_CELLS = 2
 
 
+def _check_options(structure, pair, wheel_skin, sphere_skins) -> None:
+    """:class:`WheelContact`'s arguments, refused with the offending one named."""
+    for key, value in (("wheel_skin", wheel_skin), ("sphere_skins", sphere_skins)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise WheelsoilInputError(f"{key} = {value!r} must be a finite number > 0")
+    if not isinstance(structure, Structure):
+        raise WheelsoilInputError(f"structure must be a flexwheel Structure, got {type(structure).__name__}")
+    if not isinstance(pair, PairProperties):
+        raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
+
+
 class WheelContact(Interaction):
     """Contact between the spheres of a scene and the surface facets of a wheel structure.
 
@@ -146,17 +158,13 @@ class WheelContact(Interaction):
         wheel_skin: float | None = None,
         sphere_skins: float = SPHERE_SKINS,
     ) -> None:
-        for key, value in (("wheel_skin", wheel_skin), ("sphere_skins", sphere_skins)):
-            if value is not None and not (math.isfinite(value) and value > 0):
-                raise WheelsoilInputError(f"{key} = {value!r} must be a finite number > 0")
+        _check_options(structure, pair, wheel_skin, sphere_skins)
         self._wheel_skin_request = wheel_skin
         self.sphere_skins = float(sphere_skins)
-        if not isinstance(structure, Structure):
-            raise WheelsoilInputError(f"structure must be a flexwheel Structure, got {type(structure).__name__}")
-        if not isinstance(pair, PairProperties):
-            raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
         self.structure = structure
         self.surface = ContactSurface.from_mesh(structure.mesh)
+        #: the shortest edge of the contact facets [m] (the reference of the nodes' speed limit)
+        self.shortest_edge = shortest_edge(self.surface.triangles, structure.mesh.nodes)
         wheel = structure.mesh.material
         self.soil, self.pair = soil, pair
         self.e_eff = effective_modulus(soil, wheel)
@@ -256,8 +264,11 @@ class WheelContact(Interaction):
         """Advance the wheel over [t, t + dt] with the loads of the last contact evaluation."""
         if self.advance_structure:
             self._steps += 1
-            self._last_substeps = self.structure.advance(dt, check=self._steps % self.health_every == 0)
+            check = self._steps % self.health_every == 0
+            self._last_substeps = self.structure.advance(dt, check=check)
             self.structure_substeps += self._last_substeps
+            if check:
+                require_node_speed(self.structure, self.shortest_edge, dt, self._last_substeps)
 
     def add_forces(self, scene: Scene, dt: float) -> int:
         """Evaluate every sphere--wheel contact at the current positions (see the module docstring)."""

@@ -224,6 +224,11 @@ class Structure(HubDrive, StructureReadout):
             getattr(self.arrays, k).from_numpy(np.ascontiguousarray(value))
         self.time, self.steps_taken = float(state["time"]), int(state["steps_taken"])
 
+    def max_node_speed(self) -> float:
+        """The largest node speed [m/s] (inf where a state is not finite)."""
+        worst = itg.max_speed_squared(self.arrays.v, self.arrays.w)
+        return math.sqrt(worst) if worst < 1e300 else math.inf
+
     def check_health(self) -> None:
         """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
         worst = itg.max_speed_squared(self.arrays.v, self.arrays.w)

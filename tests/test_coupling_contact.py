@@ -265,3 +265,33 @@ def test_the_anchor_lead_follows_the_wheels_rigid_motion_not_a_nodes_vibration(s
     anchor = a.x_anchor.to_numpy()[loaded]
     assert np.allclose(anchor, x + lead * rigid_now, rtol=0.0, atol=1e-15)
     assert np.abs(anchor - (x + lead * v)).max() > 1e3 * 1e-15  # the nodes' own velocities would give other anchors
+
+
+@pytest.mark.parametrize("factor, stops", [(3.0, True), (0.3, False)])
+def test_a_wheel_node_moving_past_its_share_of_an_edge_in_a_step_stops_the_run(factor, stops):
+    """A node that moves more than NODE_MOVE_PER_STEP of the shortest facet edge in one DEM step stops the run with
+    the node's speed, the limit and what to change (the contacts cannot follow it); a third of the limit does not."""
+    from wheelsoil.coupling.node_speed import NODE_MOVE_PER_STEP
+    from wheelsoil.errors import SimulationUnstableError
+
+    mesh, hub = build_wheel_mesh(LUNAR_ROVER.with_element_size(0.05))
+    st = Structure(mesh, hub_nodes=hub, hub_center=(0, 0, 0), gravity=(0, 0, 0))
+    st.drive_hub(velocity=(0, 0, 0), angular_velocity=(0, 0, 0))
+    contact = WheelContact(st, LUNAR_SOIL_SIMULANT, SOIL_STEEL, health_every=1)
+    scene = Scene((-0.7, -0.4, -0.7), (0.7, 0.4, 0.0), gravity=(0, 0, 0))
+    scene.add_spheres(np.array([[0.0, 0.0, -0.65]]), np.array([0.01]))  # clear of the wheel
+    scene.add_interaction(contact)
+    dt = scene.time_step
+    limit = NODE_MOVE_PER_STEP * contact.shortest_edge / dt
+    assert 0.005 < contact.shortest_edge < 0.05
+    tip = int(np.argmin(mesh.nodes[:, 2]))  # the lowest node: a grouser's tip, free of the hub
+    v = np.zeros((mesh.n_nodes, 3))
+    v[tip] = (0.0, 0.0, factor * limit)
+    st.set_state(velocities=v)
+    if stops:
+        with pytest.raises(SimulationUnstableError, match=r"the wheel went unstable.*soil\.time_step") as info:
+            scene.step(1)
+        assert f"{limit:.3g} m/s" in str(info.value)
+    else:
+        scene.step(1)
+        assert st.max_node_speed() < limit
