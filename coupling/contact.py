@@ -36,8 +36,7 @@ half thickness h (the contact surface lies h either side of the facet's mid-surf
   are applied: a shell node's small rotary inertia would make them stiff;
 * the wheel advances over a DEM step with the forces of the last evaluation, each node's force
   linearised with the contacts' lumped normal stiffness, f - k (x - x_a), about x_a, the node's position carried
-  ahead at the wheel's rigid velocity there to the mean of the sub-steps' positions (:func:`.kernels.node_load`;
-  carried at the node's own velocity, the lead pumped a grouser tip's vibration until it threw a grain): holding the force
+  ahead at its velocity to the mean of the sub-steps' positions (:func:`.kernels.node_load`): holding the force
   constant instead lets light nodes (a coarse grouser's tip) that several loaded spheres press on run unstable at
   the DEM step, and linearising about the evaluated position itself gives a node moving into the soil more than f
   on average, so the wheel did not carry the force the soil reported (issue 35);
@@ -89,7 +88,7 @@ HISTORY_KEYS = ("hist_n", "hist_xi", "hist_roll", "hist_count")
 
 
 def anchor_lead(interval: float, substeps: int) -> float:
-    """How far ahead [s], at the wheel's rigid velocity there, a node's linearised contact force is anchored: Delta t (n - 1) /
+    """How far ahead [s], at its present velocity, a node's linearised contact force is anchored: Delta t (n - 1) /
     (2 n), the mean time of the n sub-steps' force evaluations over the interval Delta t (each evaluates before it
     moves the node). A node moving steadily then receives exactly the evaluated force on average
     (:func:`.kernels.node_load`)."""

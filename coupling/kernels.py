@@ -15,7 +15,6 @@ The candidate lists are rebuilt by :mod:`.candidate_kernels`; here is the work o
 
 import taichi as ti
 
-from wheelsoil.flexwheel.integrator import HUB_POSITION, HUB_SPIN, HUB_VELOCITY
 from wheelsoil.graph_launch import GraphKernel
 from wheelsoil.granular.contact import hertz_mindlin
 from wheelsoil.taichi_types import nd_f64, nd_f64_2d, nd_i32, nd_i32_2d, nd_vec3, nd_vec3_2d, vec3
@@ -139,26 +138,18 @@ def facet_moment_forces(s: ti.i32, xw: ti.template(), tri: ti.template(), moment
 def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corners: ti.template(),
               facet_start: ti.template(), facet_entries: ti.template(), keep: ti.template(), bary: ti.template(),
               f_wheel: ti.template(), m_wheel: ti.template(), stiffness: ti.template(), xw: ti.template(),
-              tri: ti.template(), f_ext: ti.template(), k_ext: ti.template(), x_anchor: ti.template(),
-              hub: ti.template(), anchor_lead: ti.f64):
+              vw: ti.template(), tri: ti.template(), f_ext: ti.template(), k_ext: ti.template(),
+              x_anchor: ti.template(), anchor_lead: ti.f64):
     """Phase D, surface node ``u``: gather the reactions of the kept contacts on its facets (barycentric share
     of the force, plus the moment's nodal force lam x arm) and their lumped normal stiffness; a gather, so
     no two threads write one node.
 
     The structure feels f - k (x - x_anchor) over its sub-steps (:func:`wheelsoil.flexwheel.integrator.node_update`).
-    The anchor is the node's position carried ``anchor_lead`` seconds ahead at the wheel's rigid velocity there
-    (the hub's velocity plus its spin crossed with the node's arm from the hub centre), the mean of the positions at
-    which the n sub-steps of the next interval evaluate the force (Delta t (n - 1) / (2 n)): so a node moving with
-    the wheel receives exactly f on average, the force the spheres received the reaction of. Anchored at the present
-    position instead, a node moving down into the soil received f plus k v Delta t (n - 1) / (2 n): the wheel was
-    held up by more than the soil's reported force (issue 35: F_z below W at 1/6 g).
-
-    The lead takes the rigid velocity, not the node's own: the lead's force k lead v is a force along the velocity
-    it is taken from, so on a node's own vibration it is a negative damper of k lead [N s/m]. Where the DEM step spans
-    several of the wheel's sub-steps, a light node that loaded spheres press on (a grouser's tip) then rattles at
-    the DEM step and grows: on 2026-12-07 a grouser tip of the gravity study's soil-stiffness variant (five sub-steps
-    a DEM step) grew from 12 to 250 m/s in 0.35 s and threw a grain out at 20 m/s; with no lead its rattle decayed
-    (docs/gravity-terms/README.md). A hub-less structure has a hub state of zeros and so no lead."""
+    The anchor is the node's position carried ``anchor_lead`` seconds ahead at its present velocity, the mean of the
+    positions at which the n sub-steps of the next interval evaluate the force (Delta t (n - 1) / (2 n)): so a node
+    moving steadily receives exactly f on average, the force the spheres received the reaction of. Anchored at the
+    present position instead, a node moving down into the soil received f plus k v Delta t (n - 1) / (2 n): the
+    wheel was held up by more than the soil's reported force (issue 35: F_z below W at 1/6 g)."""
     node = nodes[u]
     f = vec3(0.0)
     stiff = 0.0
@@ -173,8 +164,7 @@ def node_load(u: ti.i32, nodes: ti.template(), corner_start: ti.template(), corn
                 stiff += bary[e, k] * stiffness[e]
     f_ext[node] = f
     k_ext[node] = stiff
-    v_rigid = hub[HUB_VELOCITY] + hub[HUB_SPIN].cross(xw[node] - hub[HUB_POSITION])
-    x_anchor[node] = xw[node] + anchor_lead * v_rigid
+    x_anchor[node] = xw[node] + anchor_lead * vw[node]
 
 
 @ti.func
@@ -302,7 +292,7 @@ def wheel_contacts(
     largest = 0.0
     for u in nodes:
         node_load(u, nodes, corner_start, corners, facet_start, facet_entries, keep, bary, f_wheel, m_wheel,
-                  stiffness, xw, tri, f_ext, k_ext, x_anchor, hub, anchor_lead)
+                  stiffness, xw, vw, tri, f_ext, k_ext, x_anchor, anchor_lead)
         ti.atomic_max(largest, (xw[nodes[u]] - node_ref[u]).norm_sqr())
     # resultant on the wheel: force and moment about the hub centre (serial sum: deterministic)
     ti.loop_config(serialize=True)
