@@ -57,7 +57,7 @@ def table(rows: list[dict]) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", nargs="+", type=int, default=[0, 1])
+    ap.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
     ap.add_argument("--cache", default=None, help="bed cache folder (default: wheelsoil's)")
     ap.add_argument("--out", default=None, help="write the table (Markdown) here")
     args = ap.parse_args(argv)
