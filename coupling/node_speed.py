@@ -12,7 +12,6 @@ from __future__ import annotations
 import numpy as np
 
 from wheelsoil.errors import SimulationUnstableError
-from wheelsoil.flexwheel.structure import Structure
 
 #: A wheel node moving more than this fraction of the shortest contact facet edge in one DEM step is a blow-up. The
 #: grouser tip above moved 67 mm in a step against the 4.5 mm this allows on its mesh; a rolling wheel's nodes move
@@ -26,15 +25,14 @@ def shortest_edge(triangles: np.ndarray, nodes: np.ndarray) -> float:
                      for a, b in ((0, 1), (1, 2), (2, 0))))
 
 
-def require_node_speed(structure: Structure, edge: float, dt: float, substeps: int) -> None:
-    """Raise :class:`SimulationUnstableError` when a node of ``structure`` moves faster than
-    :data:`NODE_MOVE_PER_STEP` ``edge`` [m] per DEM step ``dt`` [s]; ``substeps``: the wheel's sub-steps in that step
-    (for the message)."""
-    speed = structure.max_node_speed()
+def require_node_speed(speed: float, edge: float, dt: float, substeps: int, t: float) -> None:
+    """Raise :class:`SimulationUnstableError` when the wheel's fastest node, at ``speed`` [m/s] at time ``t`` [s],
+    moves more than :data:`NODE_MOVE_PER_STEP` ``edge`` [m] per DEM step ``dt`` [s]; ``substeps``: the wheel's
+    sub-steps in that step (for the message)."""
     limit = NODE_MOVE_PER_STEP * edge / dt
     if speed > limit:
         raise SimulationUnstableError(
-            f"the wheel went unstable at t = {structure.time:.6g} s: a node moves at {speed:.3g} m/s, "
+            f"the wheel went unstable at t = {t:.6g} s: a node moves at {speed:.3g} m/s, "
             f"{speed * dt * 1e3:.3g} mm in a DEM step of {dt:.3g} s, more than {NODE_MOVE_PER_STEP:g} of the "
             f"shortest contact facet edge ({edge * 1e3:.3g} mm; {limit:.3g} m/s). The contacts are evaluated once "
             f"a DEM step ({substeps} wheel sub-steps each), so they cannot follow it: shorten the DEM step "

@@ -229,16 +229,18 @@ class Structure(HubDrive, StructureReadout):
         worst = itg.max_speed_squared(self.arrays.v, self.arrays.w)
         return math.sqrt(worst) if worst < 1e300 else math.inf
 
-    def check_health(self) -> None:
-        """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large."""
-        worst = itg.max_speed_squared(self.arrays.v, self.arrays.w)
+    def check_health(self) -> float:
+        """Raise :class:`SimulationUnstableError` if any node velocity is NaN/inf or absurdly large; return the
+        largest node speed [m/s] (:meth:`max_node_speed`), for checks of the caller's own."""
+        speed = self.max_node_speed()
         limit = 1e3 * self.mesh.material.wave_speed
-        if not worst < limit**2:
+        if not speed < limit:
             raise SimulationUnstableError(
                 f"the wheel structure went unstable at t={self.time:.6g} s: node speed "
-                f"{math.sqrt(worst) if worst < 1e300 else float('nan'):.3g} m/s (limit {limit:.3g} m/s, NaN means "
+                f"{speed if speed < math.inf else float('nan'):.3g} m/s (limit {limit:.3g} m/s, NaN means "
                 "non-finite state). Reduce the time step (safety) or the loads."
             )
+        return speed
 
     # ------------------------------------------------------------------ rigid moves
     def translate(self, offset) -> None:
