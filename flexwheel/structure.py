@@ -32,6 +32,19 @@ __all__ = ["DEFAULT_SAFETY", "MomentumAccount", "Structure"]
 DEFAULT_SAFETY = 0.9
 
 
+#: Meshes of at most this many elements step serially on a CPU backend (:func:`serial_by_default`).
+SERIAL_ELEMENT_LIMIT = 1_000
+
+
+def serial_by_default(rigid: bool, n_elements: int, arch: str) -> bool:
+    """Whether a structure steps in one serial kernel launch unless told otherwise: on a CPU backend, a rigid
+    structure (its step evaluates no element: the CMU wheel's 1,540 nodes step in 0.19 ms serially against 0.40 ms
+    in parallel loops, ``benchmarks/README.md``) and a mesh of at most :data:`SERIAL_ELEMENT_LIMIT` elements, where
+    parallel-loop dispatch costs more than the work. On a device backend never: there a serial loop runs on one of
+    its thousands of threads, each far slower than a CPU core."""
+    return arch == "cpu" and (bool(rigid) or int(n_elements) <= SERIAL_ELEMENT_LIMIT)
+
+
 class Structure(HubDrive, StructureReadout):
     """A shell/beam structure advanced by explicit central differences on Taichi.
 
@@ -48,14 +61,10 @@ class Structure(HubDrive, StructureReadout):
     gravity: acceleration of gravity [m/s^2] (vector).
     safety: fraction of the critical step used by :meth:`advance` (0 < safety <= 1).
     arch: Taichi backend (see :func:`wheelsoil.runtime.init`).
-    serial: run whole batches of steps in one serial kernel launch (default: for meshes of at most
-        ``SERIAL_ELEMENT_LIMIT`` elements, where parallel-loop dispatch costs more than the work, and for every
-        rigid structure, whose step evaluates no element: the CMU wheel's 1,540 nodes step in 0.19 ms serially
-        against 0.40 ms in parallel loops, benchmarks/README.md); larger meshes step with parallel loops, several
-        steps per launch (:mod:`.stepper`).
+    serial: run whole batches of steps in one serial kernel launch (default: :func:`serial_by_default`);
+        otherwise the step runs parallel loops, several steps per launch (:mod:`.stepper`).
     """
 
-    SERIAL_ELEMENT_LIMIT = 1_000
     MAX_STEPS_PER_LAUNCH = 20_000
     #: Largest number of steps unrolled into one parallel launch (one kernel is compiled per count up to it).
     #: Compile time grows faster than the unrolled body: on the 25,920-element lunar-rover mesh one step
@@ -133,7 +142,7 @@ class Structure(HubDrive, StructureReadout):
         self._node_mass = self.arrays.mass.to_numpy()
         self._free = self.arrays.free.to_numpy().astype(bool)
         self._hub_mass = float(hub_mass + self._node_mass[hub].sum()) if hub.size else 0.0
-        self.serial = (self.rigid or mesh.n_elements <= self.SERIAL_ELEMENT_LIMIT) if serial is None else bool(serial)
+        self.serial = serial_by_default(self.rigid, mesh.n_elements, self.arch) if serial is None else bool(serial)
 
     # ------------------------------------------------------------------ time stepping
     @property

@@ -6,8 +6,9 @@
 # package-dir maps them) go into one folder on PYTHONPATH. Then, each step under its own time limit so one that hangs
 # leaves the others their time, with WHEELSOIL_ARCH=cuda (the same code; ARCH=cpu rehearses it here):
 #   1. the backend answers (runtime.init, the device named);
-#   2. verification tests on that backend: the Hertz / Mindlin contact checks, the beam and ring elements, the
-#      sphere-wheel contact, the bed and the force balance (the tests read WHEELSOIL_ARCH, tests/conftest.py);
+#   2. verification tests on that backend, those of tests/portable.txt: the Hertz / Mindlin contact checks, the beam
+#      and ring elements, the sphere-wheel contact, the bed and the force balance (the tests read WHEELSOIL_ARCH,
+#      tests/conftest.py; tests/test_backends.py runs the same list on every device backend a machine has);
 #   3. benchmarks/dem_throughput.py without LIGGGHTS on the 53k bed (its bed prepared there: no cache travels);
 #   4. (STEPS="dem388k", a second run) the seed-004 388k bed as well (--memory-check).
 # Everything it writes goes to $OUT (checks.log, a log per step, nvidia-smi.txt, dem-throughput-*.json), which the
@@ -49,8 +50,7 @@ for name in $STEPS; do
     backend) step 90 backend python3 -P -c \
       "from wheelsoil import runtime; import taichi as ti; print('arch in use:', runtime.init())" ;;
     tests) step 180 tests python3 -P -m pytest -v --tb=short -p no:cacheprovider -m "not slow" \
-      tests/test_contact_verification.py tests/test_flexwheel_verification.py tests/test_coupling_contact.py \
-      tests/test_bed.py tests/test_force_balance.py ;;
+      $(grep -v '^#' tests/portable.txt) ;;
     dem53k) step 240 dem53k python3 -P -m wheelsoil.benchmarks.dem_throughput --no-liggghts --rounds 2 --steps 1000 \
       --out "$OUT/dem-throughput-53k-$ARCH.json" ;;
     dem388k) step 420 dem388k python3 -P -m wheelsoil.benchmarks.dem_throughput --no-liggghts --rounds 1 \

@@ -19,7 +19,7 @@ def add_set_option(p: argparse.ArgumentParser, help: str = "override a case key 
 def add_arch_option(p: argparse.ArgumentParser, what: str = "") -> None:
     """``--arch``: the Taichi backend (``what``: whose, e.g. "of every case")."""
     p.add_argument("--arch", default=None, help=f"Taichi backend{' ' + what if what else ''}: cpu (default), cuda, "
-                                                "vulkan, metal")
+                                                "vulkan, metal, or gpu (the first of cuda and vulkan found)")
 
 
 def add_pool_options(p: argparse.ArgumentParser, unit: str, workers_default: int | None, workers_help: str) -> None:
