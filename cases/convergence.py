@@ -12,6 +12,7 @@ factor                  what changes (``scale`` multiplies the reference value) 
                         every level at one DEM step (the finest level's: see below)
 ``depth``               ``soil.depth``                                                   1, 2
 ``width``               ``soil.width``                                                   1, 2
+``length``              ``soil.length`` (on request: not among the default factors)      1, 2
 ``time_step``           ``soil.time_step`` (of the reference run: the same bed)          1, 0.5
 ``mesh``                ``wheel.element_size``                                           1, 0.5
 ======================  ===============================================================  =================
@@ -27,8 +28,15 @@ did not reach a steady state makes its changes unreportable, and the report says
 steady levels are extrapolated to scale 0 (:func:`.convergence_report.extrapolation_rows`: a line in the scale weighted by each run's
 standard error, :mod:`wheelsoil.scale_extrapolation`), and the factor is converged when the reference's error
 against the extrapolated value, plus two standard errors, is within ``threshold`` (10 %) for every quantity: one
-refinement that moves little is not convergence. Depth and width (doubled, not refined) are converged from the
-level whose every quantity changes by less than the threshold to the next.
+refinement that moves little is not convergence. Depth, width and length (doubled, not refined) are converged from
+the level whose every quantity changes by less than the threshold to the next.
+
+The bin's length matters where the wheel pushes soil along the travel: at a steering angle near 90° the wheel
+ploughs sideways, its side face driving a passive zone ahead of it whose length (about the sinkage times
+tan(45° + φ/2), 0.14-0.20 m for the CMU twin's 70-80 mm at φ = 39-45°) is that of the free soil a moving patch
+keeps ahead (:mod:`wheelsoil.coupling.patch`). On a periodic bin the wheel starts near the rear end, its clearance
+behind the same at every length, so the whole added length goes ahead of it: on the twin's 0.3 m bin at 90° the free
+soil ahead of the wheel's face grows from about 0.15 m to 0.45 m.
 
 The refined levels may drive up to twice the base case's ``test.drive_time`` (``--level-drive-time``): they
 stop once steady, like the reference, but a finer bed's quantities settle more slowly per simulated second.
@@ -67,7 +75,10 @@ DEFAULT_LEVELS = {
     "width": (1.0, 2.0),
     "time_step": (1.0, 0.5),
     "mesh": (1.0, 0.5),
+    "length": (1.0, 2.0),
 }
+#: The factors a study runs unless told which: all but ``length`` (a check for ploughing wheels, on request).
+DEFAULT_FACTORS = ("particle_size", "depth", "width", "time_step", "mesh")
 
 #: Reported quantities: summary key -> (label, unit, scale to the printed unit).
 QUANTITIES = {
@@ -170,6 +181,8 @@ def level_overrides(case: CaseFile, factor: str, scale: float, reference_time_st
         return {"soil.depth": s.depth * scale}
     if factor == "width":
         return {"soil.width": s.width * scale}
+    if factor == "length":
+        return {"soil.length": s.length * scale}
     if factor == "mesh":
         size = w.element_size if w.element_size is not None else build.wheel_geometry(case).element_size
         return {"wheel.element_size": size * scale}
@@ -195,7 +208,7 @@ def make_study(base: CaseFile, out: str | Path, levels: dict | None = None, thre
     out = Path(out)
     if particle_step not in PARTICLE_STEPS:
         raise WheelsoilInputError(f"particle_step = {particle_step!r}: choose {' or '.join(PARTICLE_STEPS)}")
-    levels = {k: _check_levels(k, v) for k, v in (levels or DEFAULT_LEVELS).items()}
+    levels = {k: _check_levels(k, v) for k, v in (levels or {f: DEFAULT_LEVELS[f] for f in DEFAULT_FACTORS}).items()}
     if not 0 < threshold < 1:
         raise WheelsoilInputError(f"threshold = {threshold!r} must lie in (0, 1)")
     if level_drive_time is None:
@@ -298,5 +311,5 @@ def parse_levels(text: str | None, factor: str) -> tuple[float, ...]:
     return _check_levels(factor, values)
 
 
-__all__ = ["DEFAULT_LEVELS", "QUANTITIES", "ConvergenceStudy", "Level", "make_study", "run_study", "level_overrides",
+__all__ = ["DEFAULT_FACTORS", "DEFAULT_LEVELS", "QUANTITIES", "ConvergenceStudy", "Level", "make_study", "run_study", "level_overrides",
            "parse_levels", "plan", "CaseError"]

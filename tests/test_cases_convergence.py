@@ -42,6 +42,23 @@ def test_levels_change_only_their_keys(mini, tmp_path):
     assert build.bed_spec(again.levels["time_step"][1].case) == build.bed_spec(again.reference.case)  # the same bed
 
 
+def test_the_bin_length_is_a_factor_on_request_only(tmp_path):
+    """A ploughing wheel's check (the CMU twin at 90 deg): the length doubles the periodic bin along the travel, every
+    other key as it is, and the wheel keeps its start, so the whole added length lies ahead of it."""
+    from wheelsoil.coupling.patch_geometry import PatchGeometry
+
+    case = load_case("cmu-grouser", ["test.slip_angle=90"])
+    study = cv.make_study(case, tmp_path, {"length": (1, 2)})
+    ref, longer = study.reference.case, study.levels["length"][1].case
+    assert longer.soil.length == pytest.approx(2 * ref.soil.length)
+    assert longer.soil.model_copy(update={"length": ref.soil.length}) == ref.soil
+    assert longer.wheel == ref.wheel and longer.test.model_copy(update={"drive_time": ref.test.drive_time}) == ref.test
+    reach, shift, dmax = 0.063, 0.2 * 0.058, ref.soil.diameter_max
+    start = [PatchGeometry.for_wheel(c.soil.length, reach, shift, dmax).check(None) for c in (ref, longer)]
+    assert start[0] == pytest.approx(start[1])
+    assert "length" not in cv.make_study(case, tmp_path / "default").levels
+
+
 def test_particle_levels_share_the_finest_levels_dem_step(mini, tmp_path):
     """By default every particle-size level, the reference's size included (a case of its own), runs at the
     reference's DEM step times the finest scale, so the series changes the particles and not the step; the

@@ -23,11 +23,12 @@ def add_parser(sub) -> None:
     p.add_argument("case", nargs="?", default="smoke-1g-steer", help="case file (.toml) or preset name")
     common.add_set_option(p)
     for factor, levels in (("particle-size", "1,0.8,0.64"), ("depth", "1,2"), ("width", "1,2"),
-                           ("time-step", "1,0.5"), ("mesh", "1,0.5")):
+                           ("time-step", "1,0.5"), ("mesh", "1,0.5"), ("length", "1,2")):
         p.add_argument(f"--{factor}-levels", default=None, metavar="SCALES",
                        help=f"scales of {factor.replace('-', ' ')}, reference 1 first (default {levels})")
     p.add_argument("--factors", default="particle_size,depth,width,time_step,mesh",
-                   help="factors to study, comma-separated (default: all five)")
+                   help="factors to study, comma-separated (default: all five; 'length', the bin along the travel, "
+                        "on request: for a wheel ploughing sideways)")
     p.add_argument("--threshold", type=float, default=0.10, help="largest relative change called converged "
                                                                  "(default 0.10)")
     p.add_argument("--out", type=Path, default=None, help="study folder (default wheelsoil-output/convergence/<case>)")
