@@ -14,12 +14,22 @@ bed prepared from the same case with the same code on the same backend is: ``tes
 carried run on a bed prepared again); its result holds only the frames from the carry on and says so in its run info
 (``frames_lost_before`` [s]). Packing never moves a run backwards: a checkpoint is unpacked only into a folder with no
 finished result and no checkpoint as new or newer.
+
+Finished runs of a long sweep travel too, on request (``finished_in``): a sweep of 54 cases of 10 minutes outlasts a
+session, and a fresh machine that has lost its finished cases runs them again. :func:`pack_finished` keeps a finished
+result without its frames (``<case hash>.result.h5``: the series, summary, stages, run info and mesh, compressed; a
+smoke case's is tens of kB) and :func:`unpack_run` puts it back as the case folder's ``result.h5`` with an empty
+``/frames`` group and ``frames_dropped`` in its run info, so the sweep finds the case finished and its tables read it
+(:func:`~.results.load_result`). A finished carry is never replaced or removed by packing: it is that run's record.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
+
+import h5py
 
 from wheelsoil.errors import WheelsoilInputError
 from wheelsoil.state_file import load_meta, load_state, save_state
@@ -29,6 +39,8 @@ from .run import CHECKPOINT_NAME, RESULT_NAME
 
 #: A carried run's file name: its case hash and this suffix.
 CARRY_SUFFIX = ".carry.h5"
+#: A carried finished run's file name: its case hash and this suffix.
+FINISHED_SUFFIX = ".result.h5"
 #: The checkpoint metadata a carry keeps (:mod:`.run`'s module docstring).
 CHECKPOINT_META = ("case_hash", "t", "checkpoints", "frames")
 #: Checkpoints larger than this on disk are not packed by default [MB] (a carry is meant to travel in a repository;
@@ -89,8 +101,91 @@ def pack_run(folder: Path, runs: Path, dest: Path) -> Carried:
     return Carried(relative, meta["case_hash"], float(meta["t"]), out, "packed")
 
 
-def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list[Carried]:
-    """Pack every unfinished run under ``runs`` (:func:`unfinished_runs`) into ``dest``. Skipped, and said: a
+def finished_carry_path(dest: Path, case_hash: str) -> Path:
+    """Where the carry of finished case ``case_hash`` lies in ``dest``."""
+    return Path(dest) / f"{case_hash}{FINISHED_SUFFIX}"
+
+
+def finished_runs(runs: Path) -> list[Path]:
+    """The run folders under ``runs`` (itself included) with a finished result, sorted."""
+    runs = Path(runs)
+    return sorted(p.parent for p in runs.rglob(RESULT_NAME)) if runs.is_dir() else []
+
+
+def _copy_compressed(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = ()) -> None:
+    """Copy ``src``'s attributes, datasets (gzip) and groups into ``dst``, leaving out the members named in ``skip``."""
+    for key, value in src.attrs.items():
+        dst.attrs[key] = value
+    for name, item in src.items():
+        if name in skip:
+            continue
+        if isinstance(item, h5py.Group):
+            _copy_compressed(item, dst.create_group(name))
+        else:
+            data = item[()]
+            big = getattr(data, "size", 1) > 1
+            d = dst.create_dataset(name, data=data, **({"compression": "gzip"} if big else {}))
+            for key, value in item.attrs.items():
+                d.attrs[key] = value
+
+
+def pack_finished(folder: Path, runs: Path, dest: Path) -> Carried:
+    """Pack the finished result in ``folder`` (under ``runs``) into ``dest`` without its frames, compressed, with the
+    run folder's path relative to ``runs`` (module docstring). Keeps a finished carry of the case already there."""
+    folder, runs = Path(folder), Path(runs)
+    result = folder / RESULT_NAME
+    if not result.is_file():
+        raise WheelsoilInputError(f"{folder} holds no finished run ({RESULT_NAME}): nothing to carry")
+    relative = folder.resolve().relative_to(runs.resolve()).as_posix()
+    with h5py.File(result, "r") as f:
+        case_hash = str(f.attrs.get("case_hash", ""))
+        if not case_hash or not f.attrs.get("complete", False):
+            raise WheelsoilInputError(f"{result} is not a complete result with a case hash: not carried")
+        t = float(f["summary"].attrs.get("window_end", 0.0)) if "summary" in f else 0.0
+        out = finished_carry_path(dest, case_hash)
+        if out.is_file():
+            return Carried(relative, case_hash, t, out, "kept: packed before")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(f".{out.name}.partial")
+        with h5py.File(tmp, "w") as g:
+            _copy_compressed(f, g, skip=("frames",))
+            g.attrs["folder"] = relative
+    os.replace(tmp, out)
+    return Carried(relative, case_hash, t, out, "packed (finished, without its frames)")
+
+
+def _unpack_finished(carry: Path, runs: Path) -> Carried:
+    """Put the finished carry ``carry`` back under ``runs`` as its folder's ``result.h5`` (frames empty), unless a
+    finished result is there already."""
+    carry, runs = Path(carry), Path(runs)
+    with h5py.File(carry, "r") as f:
+        relative, case_hash = str(f.attrs.get("folder", "")), str(f.attrs.get("case_hash", ""))
+        if not relative or not case_hash or not f.attrs.get("complete", False):
+            raise WheelsoilInputError(f"{carry} is not a carried finished run (wheelsoil carry pack --finished-in)")
+        t = float(f["summary"].attrs.get("window_end", 0.0)) if "summary" in f else 0.0
+        folder = (runs / relative).resolve()
+        if runs.resolve() not in (folder, *folder.parents):
+            raise WheelsoilInputError(f"{carry} names the folder {relative!r}, outside the runs folder {runs}")
+        said = lambda done: Carried(relative, case_hash, t, carry, done)  # noqa: E731
+        if (folder / RESULT_NAME).is_file():
+            return said("kept as it is: the run has finished here")
+        folder.mkdir(parents=True, exist_ok=True)
+        if f.attrs.get("case_toml") and not (folder / "case.toml").is_file():
+            (folder / "case.toml").write_text(str(f.attrs["case_toml"]))
+        tmp = partial_path(folder / RESULT_NAME)
+        with h5py.File(tmp, "w") as g:
+            _copy_compressed(f, g)
+            del g.attrs["folder"]
+            g.create_group("frames")
+            g.require_group("run").attrs["frames_dropped"] = True
+    os.replace(tmp, folder / RESULT_NAME)
+    return said("unpacked (finished, without its frames)")
+
+
+def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB,
+              finished_in: tuple[str, ...] = ()) -> list[Carried]:
+    """Pack every unfinished run under ``runs`` (:func:`unfinished_runs`) into ``dest``, and every finished run under
+    the subfolders ``finished_in`` of ``runs`` (:func:`pack_finished`; one a case). Skipped, and said: a
     checkpoint over ``max_mb``, and one older than the carry of its case already in ``dest`` (a carry not unpacked
     here: packing never moves a run backwards). Carries in ``dest`` of runs that have finished under ``runs`` are
     removed (their results are here). Refuses two unfinished runs of one case under ``runs`` (their carries would
@@ -100,6 +195,9 @@ def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list
         raise WheelsoilInputError(f"the runs folder {runs} does not exist")
     if max_mb <= 0:
         raise WheelsoilInputError(f"--max-mb {max_mb} must be > 0")
+    for sub in finished_in:
+        if not (runs / sub).resolve().is_relative_to(runs.resolve()):
+            raise WheelsoilInputError(f"--finished-in {sub!r} is outside the runs folder {runs}")
     folders = unfinished_runs(runs)
     by_case: dict[str, list[Path]] = {}
     metas = {}
@@ -134,14 +232,25 @@ def pack_runs(runs: Path, dest: Path, *, max_mb: float = DEFAULT_MAX_MB) -> list
             carry.unlink()
             done.append(Carried(str(meta["folder"]), str(meta["case_hash"]), float(meta["t"]), carry,
                                 "removed: the run has finished here"))
+    packed_cases = {}
+    for sub in finished_in:
+        for folder in finished_runs(runs / sub):
+            item = pack_finished(folder, runs, dest)
+            if item.case_hash in packed_cases and packed_cases[item.case_hash] != item.folder:
+                item = Carried(item.folder, item.case_hash, item.t, item.carry,
+                               f"not packed: case {item.case_hash} finished in {packed_cases[item.case_hash]} too")
+            packed_cases.setdefault(item.case_hash, item.folder)
+            done.append(item)
     return done
 
 
 def unpack_run(carry: Path, runs: Path) -> Carried:
     """Put the carried checkpoint ``carry`` back under ``runs`` (its folder as packed), unless that folder holds a
     finished run or a checkpoint as new or newer; the folder's partial result, if any, is removed (its frames do not
-    belong to the carried state)."""
+    belong to the carried state). A finished carry (``*.result.h5``) goes back as the folder's result."""
     carry, runs = Path(carry), Path(runs)
+    if carry.name.endswith(FINISHED_SUFFIX):
+        return _unpack_finished(carry, runs)
     state, meta = load_state(carry)
     _check_meta(meta, carry, CHECKPOINT_META + ("folder",), "not a carried run (wheelsoil carry pack)")
     relative, t = str(meta["folder"]), float(meta["t"])
@@ -165,8 +274,10 @@ def unpack_run(carry: Path, runs: Path) -> Carried:
 
 
 def unpack_runs(dest: Path, runs: Path) -> list[Carried]:
-    """:func:`unpack_run` of every carry in ``dest`` into ``runs``."""
+    """:func:`unpack_run` of every carry in ``dest`` into ``runs``: the finished ones first (a case finished is not
+    resumed from an older checkpoint)."""
     dest = Path(dest)
     if not dest.is_dir():
         raise WheelsoilInputError(f"the carry folder {dest} does not exist")
-    return [unpack_run(c, runs) for c in sorted(dest.glob(f"*{CARRY_SUFFIX}"))]
+    carries = sorted(dest.glob(f"*{FINISHED_SUFFIX}")) + sorted(dest.glob(f"*{CARRY_SUFFIX}"))
+    return [unpack_run(c, runs) for c in carries]

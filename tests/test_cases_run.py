@@ -245,6 +245,37 @@ def test_carry_refuses_what_it_cannot_carry_and_never_packs_over_a_newer_carry(t
         unpack_run(tmp_path / "stray.carry.h5", runs)
 
 
+def test_a_finished_run_carried_without_its_frames_reads_back_as_the_same_result(reference, tmp_path):
+    import shutil
+
+    from wheelsoil.cases.carry import FINISHED_SUFFIX, pack_runs, unpack_runs
+
+    case, ref_out, _ = reference
+    here = tmp_path / "here"
+    folder = here / "sweep" / "cases" / case.case_hash()
+    shutil.copytree(ref_out, folder)
+    carried = tmp_path / "carried"
+    with pytest.raises(WheelsoilInputError, match="outside the runs folder"):
+        pack_runs(here, carried, finished_in=("../elsewhere",))
+    assert pack_runs(here, carried) == []  # finished runs travel only on request
+    [packed] = pack_runs(here, carried, finished_in=("sweep",))
+    assert packed.done == "packed (finished, without its frames)"
+    assert packed.carry == carried / f"{case.case_hash()}{FINISHED_SUFFIX}"
+    assert packed.carry.stat().st_size < (folder / RESULT_NAME).stat().st_size / 3  # the frames were most of it
+    assert [c.done for c in pack_runs(here, carried, finished_in=("sweep",))] == ["kept: packed before"]
+
+    there = tmp_path / "there"
+    [unpacked] = unpack_runs(carried, there)
+    assert unpacked.done == "unpacked (finished, without its frames)"
+    a, b = load_result(ref_out), load_result(there / packed.folder)
+    for name in SERIES_UNITS:
+        np.testing.assert_array_equal(b.series[name], a.series[name], err_msg=name)
+    assert json.dumps(b.summary.to_dict(), sort_keys=True) == json.dumps(a.summary.to_dict(), sort_keys=True)
+    assert b.case == a.case and len(b.frame_times) == 0 and b.info["frames_dropped"]
+    assert load_case(there / packed.folder / "case.toml") == case
+    assert unpack_runs(carried, there)[0].done == "kept as it is: the run has finished here"
+
+
 def test_carry_command_says_what_it_did(tmp_path, capsys):
     assert main(["carry", "pack", str(tmp_path), "--to", str(tmp_path / "c")]) == 0
     assert "no unfinished run with a checkpoint under" in capsys.readouterr().out

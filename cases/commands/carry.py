@@ -22,6 +22,9 @@ def add_parser(sub) -> None:
     pack.add_argument("--to", type=Path, required=True, metavar="DIR", help="the carry folder")
     pack.add_argument("--max-mb", type=float, default=None,
                       help="skip checkpoints larger than this on disk (default 60 MB)")
+    pack.add_argument("--finished-in", action="append", default=[], metavar="SUB",
+                      help="also pack the finished runs under RUNS/SUB, without their frames (<case hash>.result.h5), "
+                           "so that a long sweep's finished cases are not run again on the other machine; repeatable")
     unpack = how.add_parser("unpack", help="put the runs carried in DIR back under RUNS")
     unpack.add_argument("carries", type=Path, metavar="DIR", help="the carry folder")
     unpack.add_argument("--into", type=Path, required=True, metavar="RUNS", help="the runs folder")
@@ -33,8 +36,10 @@ def cmd(args) -> int:
 
     console = common.console()
     if args.action == "pack":
-        done = pack_runs(args.runs, args.to, max_mb=DEFAULT_MAX_MB if args.max_mb is None else args.max_mb)
-        empty = f"no unfinished run with a checkpoint under {args.runs}"
+        done = pack_runs(args.runs, args.to, max_mb=DEFAULT_MAX_MB if args.max_mb is None else args.max_mb,
+                         finished_in=tuple(args.finished_in))
+        empty = f"no unfinished run with a checkpoint under {args.runs}" + (
+            f" and no finished run under {', '.join(args.finished_in)}" if args.finished_in else "")
     else:
         done = unpack_runs(args.carries, args.into)
         empty = f"no carried run in {args.carries}"
