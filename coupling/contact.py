@@ -170,17 +170,21 @@ class WheelContact(Interaction):
         self.g_eff = effective_shear_modulus(soil, wheel)
         self.contact_moduli = (self.e_eff,)
         self.advance_structure = bool(advance_structure)
+        #: set aside, before their closest points, the candidates that a facet's plane or holding ball proves out of
+        #: reach (:func:`.kernels.surely_apart`): the same results, fewer closest points (False: every one found)
+        self.cull_far_candidates = True
         self.health_every = max(1, int(health_every))
         self.rebuilds = 0
         self.structure_substeps = 0
         self._last_substeps = 1  # sub-steps of the structure's last advance (the next one's, as it stays put)
         self._steps = 0
         self._n_contacts = 0
+        self._n_candidates = 0
         sf = self.surface
         self._surface_arrays = SurfaceArrays.upload(sf, structure)
         self._resultant = ti.Vector.ndarray(3, ti.f64, shape=5)
         self._resultant.fill(0.0)
-        self._stats = ti.ndarray(ti.f64, shape=2)
+        self._stats = ti.ndarray(ti.f64, shape=3)
         self._contact_arrays = None  # the contact kernel's array arguments (set at each rebuild)
         self._arrays: dict = {}
         self._scene_key = None
@@ -242,6 +246,7 @@ class WheelContact(Interaction):
                            a["wheel_gap"])
         scene.limit_allowances(a["wheel_gap"], self.wheel_skin)
         n_cand = exclusive_scan(a["count"], a["start"])
+        self._n_candidates = n_cand
         cand = self._buffer("cand", ti.i32, max(n_cand, 1))
         ck.fill_candidates(ds.x, ds.radius, self.skin, origin, inv_cell, dims, a["cell_start"], cell_facets,
                           w.x, d.triangles, d.half_thickness, a["start"], cand)
@@ -298,18 +303,31 @@ class WheelContact(Interaction):
                 (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
                  a["f_wheel"], a["m_wheel"], a["xi_new"], a["roll_new"], a["stiffness"], a["hist_n"], a["hist_xi"],
                  a["hist_roll"], a["hist_count"],
-                 w.x, w.v, w.w, d.inverse_mass, d.triangles, d.edges, d.half_thickness,
+                 w.x, w.v, w.w, d.inverse_mass, d.triangles, d.edges, d.half_thickness),
+                (d.facet_plane, d.facet_ball,
                  d.nodes, d.corner_start, d.corners, d.facet_start, a["facet_entries"],
                  w.f_ext, w.k_ext, w.x_anchor, d.node_reference, w.hub, self._resultant),
             )
-        particles, rest = self._contact_arrays
+        particles, entries, rest = self._contact_arrays
+        n_cull = self.surface.n_facets if self.cull_far_candidates else 0
         k.wheel_contacts_graph(
-            *particles, self._n_active, *rest,
+            *particles, self._n_active, *entries, n_cull, *rest,
             self.e_eff, self.g_eff, self.pair.damping_ratio, self.pair.static_friction, self.pair.rolling_friction,
             ROLLING_MODELS[self.pair.rolling_model], dt, anchor_lead(dt, self._last_substeps), self._stats,
         )
 
     # ------------------------------------------------------------------ measured quantities
+    @property
+    def candidates_set_aside(self) -> int:
+        """Candidates the last evaluation set aside by their facets' bounds, without their closest points
+        (``cull_far_candidates``; read on demand: a scalar read waits for the device)."""
+        return int(self._stats[2])
+
+    @property
+    def candidate_count(self) -> int:
+        """Candidate (sphere, facet) pairs held since the last candidate rebuild."""
+        return int(self._n_candidates)
+
     @property
     def contact_count(self) -> int:
         """Physical sphere--wheel contacts at the last evaluation."""

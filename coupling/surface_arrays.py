@@ -10,7 +10,7 @@ import numpy as np
 import taichi as ti
 
 from wheelsoil.flexwheel.structure import Structure
-from wheelsoil.taichi_types import ivec3
+from wheelsoil.taichi_types import ivec3, vec4
 from wheelsoil.taichi_types import to_ndarray as _nd
 
 from .surface import ContactSurface
@@ -38,6 +38,8 @@ class SurfaceArrays:
     facet_hi: ti.Ndarray
     facet_start: ti.Ndarray
     facet_fill: ti.Ndarray
+    facet_plane: ti.Ndarray
+    facet_ball: ti.Ndarray
 
     @classmethod
     def upload(cls, surface: ContactSurface, structure: Structure) -> "SurfaceArrays":
@@ -58,4 +60,6 @@ class SurfaceArrays:
             facet_hi=ti.ndarray(ivec3, shape=n_facets),
             facet_start=ti.ndarray(ti.i32, shape=n_facets + 1),
             facet_fill=ti.ndarray(ti.i32, shape=n_facets),
+            facet_plane=ti.ndarray(vec4, shape=n_facets),
+            facet_ball=ti.ndarray(vec4, shape=n_facets),
         )

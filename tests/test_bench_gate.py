@@ -49,3 +49,12 @@ def test_bench_command_runs_the_tier_in_its_own_process_and_passes_its_status(tm
     done = subprocess.run([sys.executable, "-c", "import sys, wheelsoil.cases.cli; "
                            "sys.exit(any(m.startswith('wheelsoil.benchmarks') for m in sys.modules))"])
     assert done.returncode == 0  # the case layer does not import the benchmarks
+
+
+def test_contact_culling_benchmark_refuses_a_folder_without_a_run_before_any_work(tmp_path, capsys):
+    from wheelsoil.benchmarks.contact_culling import main
+
+    assert main(["--run", str(tmp_path)]) == 2
+    assert f"{tmp_path} has no case.toml: give a run folder with a checkpoint" in capsys.readouterr().err
+    assert main(["--run", str(tmp_path), "--rounds", "1"]) == 2
+    assert "--rounds 1 >= 2" in capsys.readouterr().err

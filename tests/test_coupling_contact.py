@@ -252,3 +252,48 @@ def test_a_wheel_node_moving_past_its_share_of_an_edge_in_a_step_stops_the_run(f
     else:
         scene.step(1)
         assert st.max_node_speed() < limit
+
+
+def _grains_on_a_spinning_wheel(cull: bool, steps: int = 300):
+    """Grains of 2.5-3.5 mm rained on the closed CMU grouser wheel (its 6 mm facets: many candidates a grain) while
+    it spins; returns the scene's state, the wheel's nodes, the most candidates any step set aside, and the
+    grain--wheel contacts summed over the steps."""
+    from dataclasses import replace
+
+    from wheelsoil.flexwheel.geometry import CMU_K10_GROUSER
+
+    mesh, hub = build_wheel_mesh(replace(CMU_K10_GROUSER, side_walls=True))
+    st = Structure(mesh, rigid=True, hub_nodes=hub)
+    st.drive_hub(velocity=(0, 0, 0), angular_velocity=(0, 3.0, 0))
+    scene = Scene((-0.3, -0.3, -0.3), (0.3, 0.3, 0.3), gravity=(0, 0, -9.81))
+    rng = np.random.default_rng(7)
+    x, radius = [], []
+    while len(x) < 160:  # apart from each other, just outside the grousers' tips (0.063 m), all round
+        r = rng.uniform(0.0025, 0.0035)
+        angle, ring = rng.uniform(0, 2 * np.pi), 0.0645 + r + rng.uniform(0.0, 0.003)
+        p = np.array([ring * np.cos(angle), rng.uniform(-0.03, 0.03), ring * np.sin(angle)])
+        if all(np.linalg.norm(p - q) > r + rq for q, rq in zip(x, radius)):
+            x.append(p), radius.append(r)
+    x, radius = np.array(x), np.array(radius)
+    scene.add_spheres(x, radius, velocities=-0.3 * x / np.linalg.norm(x, axis=1)[:, None])
+    contact = WheelContact(st, LUNAR_SOIL_SIMULANT, SOIL_STEEL)
+    contact.cull_far_candidates = cull
+    scene.add_interaction(contact)
+    most, touching = 0, 0
+    for _ in range(steps):
+        scene.step(1)
+        most, touching = max(most, contact.candidates_set_aside), touching + contact.contact_count
+    return (scene.positions, scene.velocities, scene.angular_velocities), st.positions(), most, touching
+
+
+def test_candidates_set_aside_by_their_bounds_change_no_result():
+    """The contact evaluation sets aside the candidates that a facet's plane or holding ball proves out of reach
+    (``WheelContact.cull_far_candidates``, :func:`wheelsoil.coupling.kernels.surely_apart`); grains raining onto a
+    spinning closed wheel move the same, to the bit, with it as without it, and it did set candidates aside while
+    grains touched the wheel."""
+    with_cull = _grains_on_a_spinning_wheel(True)
+    without = _grains_on_a_spinning_wheel(False)
+    assert with_cull[2] > 0 and without[2] == 0 and with_cull[3] >= 100 and without[3] == with_cull[3]
+    for a, b in zip(with_cull[0], without[0]):
+        assert np.array_equal(a, b)
+    assert np.array_equal(with_cull[1], without[1])
