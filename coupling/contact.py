@@ -131,6 +131,22 @@ def _check_options(structure, pair, wheel_skin, sphere_skins) -> None:
         raise WheelsoilInputError(f"pair must be a PairProperties, got {type(pair).__name__}")
 
 
+def _evaluation_arrays(ds, w, a: dict, d: SurfaceArrays, resultant) -> tuple[tuple, tuple, tuple]:
+    """The array arguments of :func:`.kernels.wheel_contacts` in its order, in three runs around its two scalars
+    (the active count, the culling's facet count): the scene's particle arrays ``ds``, the candidate arrays ``a``
+    with the wheel's device arrays ``w`` and the surface's ``d``, and the rest to the ``resultant``."""
+    return (
+        (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
+        (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
+         a["f_wheel"], a["m_wheel"], a["xi_new"], a["roll_new"], a["stiffness"], a["hist_n"], a["hist_xi"],
+         a["hist_roll"], a["hist_count"],
+         w.x, w.v, w.w, d.inverse_mass, d.triangles, d.edges, d.half_thickness),
+        (d.facet_plane, d.facet_ball,
+         d.nodes, d.corner_start, d.corners, d.facet_start, a["facet_entries"],
+         w.f_ext, w.k_ext, w.x_anchor, d.node_reference, w.hub, resultant),
+    )
+
+
 class WheelContact(Interaction):
     """Contact between the spheres of a scene and the surface facets of a wheel structure.
 
@@ -170,22 +186,20 @@ class WheelContact(Interaction):
         self.g_eff = effective_shear_modulus(soil, wheel)
         self.contact_moduli = (self.e_eff,)
         self.advance_structure = bool(advance_structure)
-        #: set aside, before their closest points, the candidates that a facet's plane or holding ball proves out of
-        #: reach (:func:`.kernels.surely_apart`): the same results, fewer closest points (False: every one found)
+        #: set aside candidates their facet's bounds prove apart (:func:`.kernels.surely_apart`; the same results)
         self.cull_far_candidates = True
         self.health_every = max(1, int(health_every))
         self.rebuilds = 0
         self.structure_substeps = 0
         self._last_substeps = 1  # sub-steps of the structure's last advance (the next one's, as it stays put)
         self._steps = 0
-        self._n_contacts = 0
-        self._n_candidates = 0
+        self._n_contacts = self._n_candidates = 0
         sf = self.surface
         self._surface_arrays = SurfaceArrays.upload(sf, structure)
         self._resultant = ti.Vector.ndarray(3, ti.f64, shape=5)
         self._resultant.fill(0.0)
         self._stats = ti.ndarray(ti.f64, shape=3)
-        self._contact_arrays = None  # the contact kernel's array arguments (set at each rebuild)
+        self._contact_arrays = None  # the contact kernel's array arguments (gathered after each rebuild)
         self._arrays: dict = {}
         self._scene_key = None
         self._need_rebuild = True
@@ -204,13 +218,10 @@ class WheelContact(Interaction):
         self.r_max = float(radii.max())
         a = self._arrays
         a.clear()
-        a["count"] = ti.ndarray(ti.i32, shape=n)
-        a["start"] = ti.ndarray(ti.i32, shape=n + 1)
-        a["active"] = ti.ndarray(ti.i32, shape=n)
-        a["hist_n"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
-        a["hist_xi"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
-        a["hist_roll"] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
-        a["hist_count"] = ti.ndarray(ti.i32, shape=n)
+        for name, rows in (("count", n), ("start", n + 1), ("active", n), ("hist_count", n)):
+            a[name] = ti.ndarray(ti.i32, shape=rows)
+        for name in ("hist_n", "hist_xi", "hist_roll"):
+            a[name] = ti.Vector.ndarray(3, ti.f64, shape=(n, HISTORY_SLOTS))
         a["hist_count"].fill(0)
         a["wheel_gap"] = ti.ndarray(ti.f64, shape=n)
         self._scene_key = (id(scene), n)
@@ -295,19 +306,8 @@ class WheelContact(Interaction):
         """One evaluation of every contact (:func:`.kernels.wheel_contacts`, as a compute graph); its array
         arguments are gathered once per candidate rebuild."""
         if self._contact_arrays is None:
-            ds = self._scene_state
-            w = self.structure.device_arrays()
-            a, d = self._arrays, self._surface_arrays
-            self._contact_arrays = (
-                (ds.x, ds.v, ds.w, ds.radius, ds.mass, ds.inertia, ds.external_force, ds.external_torque),
-                (a["active"], a["start"], a["cand"], a["code"], a["keep"], a["bary"], a["normal"], a["overlap"],
-                 a["f_wheel"], a["m_wheel"], a["xi_new"], a["roll_new"], a["stiffness"], a["hist_n"], a["hist_xi"],
-                 a["hist_roll"], a["hist_count"],
-                 w.x, w.v, w.w, d.inverse_mass, d.triangles, d.edges, d.half_thickness),
-                (d.facet_plane, d.facet_ball,
-                 d.nodes, d.corner_start, d.corners, d.facet_start, a["facet_entries"],
-                 w.f_ext, w.k_ext, w.x_anchor, d.node_reference, w.hub, self._resultant),
-            )
+            self._contact_arrays = _evaluation_arrays(self._scene_state, self.structure.device_arrays(), self._arrays,
+                                                      self._surface_arrays, self._resultant)
         particles, entries, rest = self._contact_arrays
         n_cull = self.surface.n_facets if self.cull_far_candidates else 0
         k.wheel_contacts_graph(
@@ -319,8 +319,7 @@ class WheelContact(Interaction):
     # ------------------------------------------------------------------ measured quantities
     @property
     def candidates_set_aside(self) -> int:
-        """Candidates the last evaluation set aside by their facets' bounds, without their closest points
-        (``cull_far_candidates``; read on demand: a scalar read waits for the device)."""
+        """Candidates the last evaluation set aside by their facets' bounds (``cull_far_candidates``; a scalar read)."""
         return int(self._stats[2])
 
     @property
