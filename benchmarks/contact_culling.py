@@ -8,7 +8,8 @@ here on a real run's checkpoint (a deep, steered wheel holds most), not on a fre
 ``RUN/.checkpoint.h5`` and stepped on, in alternating rounds of ``--steps`` DEM steps with the culling on and off
 (the order swapped each round, so that the machine's drift falls on both alike), the contact evaluation
 (``add_forces``) timed apart from the whole coupled step; then the evaluation alone, repeated on the last state
-(``--evaluations`` a round, alternating as well), which stepping's own noise does not reach.
+(``--evaluations`` a round, alternating as well), which stepping's own noise does not reach, and its part without
+spheres (the launch, the nodes' loads, the resultant).
 
 Usage (from the repository root; a run folder with its ``case.toml`` and checkpoint, its bed from the cache or
 prepared again)::
@@ -66,6 +67,14 @@ def culling_rounds(bench, steps: int, rounds: int, evaluations: int = 40) -> dic
                 c._launch_contacts(bench.dt)
             frozen[cull].append((time.perf_counter() - t0) / evaluations)
     ratio_frozen = [off / on for on, off in zip(frozen[True], frozen[False])]
+    active, fixed = c._n_active, []  # the evaluation's part without spheres: the launch, the nodes' loads, the resultant
+    c._n_active = 0
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        for _ in range(evaluations):
+            c._launch_contacts(bench.dt)
+        fixed.append((time.perf_counter() - t0) / evaluations)
+    c._n_active = active
     ratio_contact = [off / on for on, off in zip(contact[True], contact[False])]
     return {
         "steps_per_round": steps, "rounds": rounds,
@@ -80,6 +89,7 @@ def culling_rounds(bench, steps: int, rounds: int, evaluations: int = 40) -> dic
         "ms_per_evaluation_no_cull": [1e3 * x for x in frozen[False]],
         "evaluation_no_cull_over_cull_median": statistics.median(ratio_frozen),
         "evaluation_no_cull_over_cull": ratio_frozen,
+        "ms_per_evaluation_without_spheres": [1e3 * x for x in fixed],
         **{f"{key}_median": statistics.median(v) for key, v in counts.items()},
     }
 
@@ -130,7 +140,8 @@ def main(argv=None) -> int:
           f"{statistics.median(report['ms_per_step_no_cull']):.2f} ({report['step_no_cull_over_cull_median']:.2f}); "
           f"the evaluation alone on the last state {statistics.median(report['ms_per_evaluation_cull']):.2f} ms "
           f"against {statistics.median(report['ms_per_evaluation_no_cull']):.2f} "
-          f"({report['evaluation_no_cull_over_cull_median']:.2f})")
+          f"({report['evaluation_no_cull_over_cull_median']:.2f}), of which "
+          f"{statistics.median(report['ms_per_evaluation_without_spheres']):.2f} ms without any sphere")
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.write_text(json.dumps(report, indent=1) + "\n")
