@@ -70,6 +70,10 @@ WHEEL_CANDIDATES = {
 #: The trials a wheel candidate and its baseline run: the grousered wheel at 30 and 75 deg, driving 0.5, first repeat.
 WHEEL_CANDIDATE_TRIALS = {"grouser": (30.0, 75.0)}
 WHEEL_CANDIDATE_SLIPS = (0.5,)
+#: The trials a wheel candidate's sweep holds besides, run once it is accepted: the angles whose twin runs it was chosen
+#: on (45 and 90 deg, so they cannot judge it), for information and as the closed twin's runs there, which the soil
+#: candidates and the bin checks are then owed against (docs/cmu-twin/README.md, the closed wheel's verdict).
+WHEEL_CANDIDATE_SEEN_TRIALS = {"grouser": (45.0, 90.0)}
 #: The trials a candidate runs: the grousered wheel at 0 deg (the trial whose twin showed the overprediction) and at
 #: the held-out 45 and 90 deg (no twin result seen when this was fixed), driving 0.5 and 0.9, first repeat.
 CANDIDATE_TRIALS = {"grouser": (0.0, 45.0, 90.0)}
@@ -231,11 +235,12 @@ def write_presets(folder: str | Path, presets: str | Path | None = None) -> list
     sweeps.append(("cmu-held-out-angles", held_out, "The twin as it is at steering angles none of its runs has seen "
                    "(cases/cmu_sweep.py WHEEL_CANDIDATE_TRIALS):\nthe baseline of the wheel candidates, the grousered "
                    "wheel at 30 and 75 deg, driving 0.5.", None))
+    seen = _pick(rows, WHEEL_CANDIDATE_SEEN_TRIALS, WHEEL_CANDIDATE_SLIPS)
     for name, (overrides, why) in WHEEL_CANDIDATES.items():
-        sweeps.append((f"cmu-candidate-{name}", held_out,
+        sweeps.append((f"cmu-candidate-{name}", held_out + seen,
                        f"Wheel candidate '{name}' of the CMU twin (cases/cmu_sweep.py WHEEL_CANDIDATES; "
                        f"docs/cmu-twin/README.md).\n{why}\nThe grousered wheel at 30 and 75 deg (held out), driving "
-                       "0.5.", overrides))
+                       "0.5; at 45 and 90 deg (seen), run once it is accepted.", overrides))
     for name, chosen, what, overrides in sweeps:
         chosen = chosen + longer_drives(chosen, LONGER_DRIVES.get(name, ()))
         path = presets / f"{name}.toml"

@@ -105,6 +105,12 @@ def test_the_trial_sweeps_are_written_from_the_data_and_pair_with_every_trial(me
     full, part = load_sweep("cmu-trials"), load_sweep("cmu-trials-subset")
     assert (len(full.cases), len(part.cases)) == (297, 25)
     assert {c.case.case_hash() for c in part.cases} <= {c.case.case_hash() for c in full.cases}
+    # the wheel candidate's sweep: its held-out angles, their longer drive, and the angles that chose it (run once
+    # accepted), each one case of the full sweep's trials with the wheel closed
+    closed = load_sweep("cmu-candidate-closed-wheel")
+    assert sorted((c.case.test.slip_angle, c.case.test.drive_time) for c in closed.cases) == [
+        (30.0, 20.0), (45.0, 20.0), (75.0, 20.0), (75.0, 30.0), (90.0, 20.0)]
+    assert all(c.case.wheel.side_walls for c in closed.cases)
     # the repeats of a condition are replicas: other seeds
     seeds = {}
     for c in full.cases:
