@@ -17,10 +17,11 @@ finished result and no checkpoint as new or newer.
 
 Finished runs of a long sweep travel too, on request (``finished_in``): a sweep of 54 cases of 10 minutes outlasts a
 session, and a fresh machine that has lost its finished cases runs them again. :func:`pack_finished` keeps a finished
-result without its frames (``<case hash>.result.h5``: the series, summary, stages, run info and mesh, compressed; a
-smoke case's is tens of kB) and :func:`unpack_run` puts it back as the case folder's ``result.h5`` with an empty
-``/frames`` group and ``frames_dropped`` in its run info, so the sweep finds the case finished and its tables read it
-(:func:`~.results.load_result`). A finished carry is never replaced or removed by packing: it is that run's record.
+result without its frames (``<case hash>.result.h5``: the series, summary, stages, run info and mesh, gzip with
+shuffle; a seed004-like smoke case's, 29 series of 1,800 samples and the mesh, is 0.36 MB) and :func:`unpack_run`
+puts it back as the case folder's ``result.h5`` with an empty ``/frames`` group and ``frames_dropped`` in its run
+info, so the sweep finds the case finished and its tables read it (:func:`~.results.load_result`). A finished carry
+is never replaced or removed by packing: it is that run's record.
 """
 
 from __future__ import annotations
@@ -124,7 +125,7 @@ def _copy_compressed(src: h5py.Group, dst: h5py.Group, skip: tuple[str, ...] = (
         else:
             data = item[()]
             big = getattr(data, "size", 1) > 1
-            d = dst.create_dataset(name, data=data, **({"compression": "gzip"} if big else {}))
+            d = dst.create_dataset(name, data=data, **({"compression": "gzip", "shuffle": True} if big else {}))
             for key, value in item.attrs.items():
                 d.attrs[key] = value
 
