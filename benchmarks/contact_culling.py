@@ -15,7 +15,7 @@ Usage (from the repository root; a run folder with its ``case.toml`` and checkpo
 prepared again)::
 
     WHEELSOIL_CPU_THREADS=1 python -m wheelsoil.benchmarks.contact_culling --run RUN [--steps 300] [--rounds 6] \\
-        [--out benchmarks/results/contact-culling.json]
+        [--evaluations 40] [--out benchmarks/results/contact-culling.json]
 """
 
 from __future__ import annotations
