@@ -24,72 +24,84 @@ import argparse
 import json
 import statistics
 import sys
-import time
 from pathlib import Path
 
+from wheelsoil.benchmarks.common import alternating_kernel_times
 from wheelsoil.benchmarks.coupled_rounds import _timed
+
+
+def _stepping(bench, steps: int, cull: bool, totals: dict, contact: list, counts: dict):
+    """A call that steps the testbed ``steps`` DEM steps with the culling ``cull``, appending its contact evaluation's
+    seconds per step (from ``totals``, :func:`~.coupled_rounds._timed`) to ``contact`` and, culled, the candidates,
+    contacts and those set aside to ``counts``."""
+    c = bench.contact
+
+    def call():
+        c.cull_far_candidates = cull
+        c0 = totals["contact"]
+        bench.scene.step(steps)
+        contact.append((totals["contact"] - c0) / steps)
+        if cull:
+            counts["set_aside"].append(c.candidates_set_aside)
+            counts["candidates"].append(c.candidate_count)
+            counts["contacts"].append(c.contact_count)
+    return call
+
+
+def _evaluation(contact, dt: float, cull: bool, spheres: bool = True):
+    """A call that evaluates the contact once on the testbed's present state, with the culling ``cull``, and without
+    any active sphere unless ``spheres`` (then only the launch, the nodes' loads and the resultant run)."""
+    def call():
+        contact.cull_far_candidates = cull
+        active = contact._n_active
+        if not spheres:
+            contact._n_active = 0
+        contact._launch_contacts(dt)
+        contact._n_active = active
+    return call
+
+
+def _ratios(on, off) -> list[float]:
+    return [float(b / a) for a, b in zip(on, off)]
 
 
 def culling_rounds(bench, steps: int, rounds: int, evaluations: int = 40) -> dict:
     """``rounds`` pairs of ``steps`` coupled DEM steps of the testbed ``bench``, the culling on and off in turn; the
     wall per step of each and of its contact evaluation, and the candidates, contacts and those set aside; then
-    ``rounds`` pairs of ``evaluations`` contact evaluations on the last state alone. Leaves the testbed's spheres
-    with forces added many times over: step it no further."""
+    ``rounds`` rounds of ``evaluations`` contact evaluations on the last state alone, culled, not culled and without
+    spheres in turn (:func:`~.common.alternating_kernel_times` times both). Leaves the testbed's spheres with forces
+    added many times over: step it no further."""
     c, scene = bench.contact, bench.scene
     totals = {"contact": 0.0}
     _timed(c, "add_forces", totals, "contact")
     for cull in (True, False):  # compile both
         c.cull_far_candidates = cull
         scene.step(10)
-    per = {True: [], False: []}
     contact = {True: [], False: []}
     counts = {"candidates": [], "contacts": [], "set_aside": []}
-    for k in range(rounds):
-        for cull in ((True, False) if k % 2 == 0 else (False, True)):
-            c.cull_far_candidates = cull
-            c0 = totals["contact"]
-            t0 = time.perf_counter()
-            scene.step(steps)
-            per[cull].append((time.perf_counter() - t0) / steps)
-            contact[cull].append((totals["contact"] - c0) / steps)
-            if cull:
-                counts["set_aside"].append(c.candidates_set_aside)
-                counts["candidates"].append(int(c.candidate_count))
-                counts["contacts"].append(c.contact_count)
-    ratio = [off / on for on, off in zip(per[True], per[False])]
-    frozen = {True: [], False: []}  # the evaluation alone, repeated on the last state (it adds its forces again and
-    for k in range(rounds):         # again to the spheres' external forces: nothing is stepped after it)
-        for cull in ((True, False) if k % 2 == 0 else (False, True)):
-            c.cull_far_candidates = cull
-            c._launch_contacts(bench.dt)
-            t0 = time.perf_counter()
-            for _ in range(evaluations):
-                c._launch_contacts(bench.dt)
-            frozen[cull].append((time.perf_counter() - t0) / evaluations)
-    ratio_frozen = [off / on for on, off in zip(frozen[True], frozen[False])]
-    active, fixed = c._n_active, []  # the evaluation's part without spheres: the launch, the nodes' loads, the resultant
-    c._n_active = 0
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        for _ in range(evaluations):
-            c._launch_contacts(bench.dt)
-        fixed.append((time.perf_counter() - t0) / evaluations)
-    c._n_active = active
-    ratio_contact = [off / on for on, off in zip(contact[True], contact[False])]
+    per = alternating_kernel_times({cull: _stepping(bench, steps, cull, totals, contact[cull], counts)
+                                    for cull in (True, False)}, rounds, repeats=1)
+    per = {cull: per[cull] / steps for cull in per}
+    # the evaluation alone, repeated on the last state (it adds its forces again and again to the spheres' external
+    # forces: nothing is stepped after it)
+    calls = {"cull": _evaluation(c, bench.dt, True), "no_cull": _evaluation(c, bench.dt, False),
+             "without_spheres": _evaluation(c, bench.dt, True, spheres=False)}
+    frozen = alternating_kernel_times(calls, rounds, repeats=evaluations)
+    ratio, ratio_contact = _ratios(per[True], per[False]), _ratios(contact[True], contact[False])
+    ratio_frozen = _ratios(frozen["cull"], frozen["no_cull"])
+    ms = lambda xs: [1e3 * float(x) for x in xs]  # noqa: E731
     return {
         "steps_per_round": steps, "rounds": rounds,
-        "ms_per_step_cull": [1e3 * x for x in per[True]], "ms_per_step_no_cull": [1e3 * x for x in per[False]],
-        "ms_per_step_contact_cull": [1e3 * x for x in contact[True]],
-        "ms_per_step_contact_no_cull": [1e3 * x for x in contact[False]],
+        "ms_per_step_cull": ms(per[True]), "ms_per_step_no_cull": ms(per[False]),
+        "ms_per_step_contact_cull": ms(contact[True]), "ms_per_step_contact_no_cull": ms(contact[False]),
         "step_no_cull_over_cull_median": statistics.median(ratio), "step_no_cull_over_cull": ratio,
         "contact_no_cull_over_cull_median": statistics.median(ratio_contact),
         "contact_no_cull_over_cull": ratio_contact,
         "evaluations_per_round": evaluations,
-        "ms_per_evaluation_cull": [1e3 * x for x in frozen[True]],
-        "ms_per_evaluation_no_cull": [1e3 * x for x in frozen[False]],
+        "ms_per_evaluation_cull": ms(frozen["cull"]), "ms_per_evaluation_no_cull": ms(frozen["no_cull"]),
         "evaluation_no_cull_over_cull_median": statistics.median(ratio_frozen),
         "evaluation_no_cull_over_cull": ratio_frozen,
-        "ms_per_evaluation_without_spheres": [1e3 * x for x in fixed],
+        "ms_per_evaluation_without_spheres": ms(frozen["without_spheres"]),
         **{f"{key}_median": statistics.median(v) for key, v in counts.items()},
     }
 

@@ -102,6 +102,19 @@ def pack_run(folder: Path, runs: Path, dest: Path) -> Carried:
     return Carried(relative, meta["case_hash"], float(meta["t"]), out, "packed")
 
 
+def _folder_under(runs: Path, relative: str, carry: Path) -> Path:
+    """The folder ``relative`` that ``carry`` names, resolved under ``runs``; refused when it lies outside."""
+    folder = (runs / relative).resolve()
+    if runs.resolve() not in (folder, *folder.parents):
+        raise WheelsoilInputError(f"{carry} names the folder {relative!r}, outside the runs folder {runs}")
+    return folder
+
+
+def _window_end(result: h5py.File) -> float:
+    """The end [s] of a result's steady-state window (its summary's), the time a finished carry is shown at."""
+    return float(result["summary"].attrs.get("window_end", 0.0)) if "summary" in result else 0.0
+
+
 def finished_carry_path(dest: Path, case_hash: str) -> Path:
     """Where the carry of finished case ``case_hash`` lies in ``dest``."""
     return Path(dest) / f"{case_hash}{FINISHED_SUFFIX}"
@@ -142,7 +155,7 @@ def pack_finished(folder: Path, runs: Path, dest: Path) -> Carried:
         case_hash = str(f.attrs.get("case_hash", ""))
         if not case_hash or not f.attrs.get("complete", False):
             raise WheelsoilInputError(f"{result} is not a complete result with a case hash: not carried")
-        t = float(f["summary"].attrs.get("window_end", 0.0)) if "summary" in f else 0.0
+        t = _window_end(f)
         out = finished_carry_path(dest, case_hash)
         if out.is_file():
             return Carried(relative, case_hash, t, out, "kept: packed before")
@@ -163,10 +176,8 @@ def _unpack_finished(carry: Path, runs: Path) -> Carried:
         relative, case_hash = str(f.attrs.get("folder", "")), str(f.attrs.get("case_hash", ""))
         if not relative or not case_hash or not f.attrs.get("complete", False):
             raise WheelsoilInputError(f"{carry} is not a carried finished run (wheelsoil carry pack --finished-in)")
-        t = float(f["summary"].attrs.get("window_end", 0.0)) if "summary" in f else 0.0
-        folder = (runs / relative).resolve()
-        if runs.resolve() not in (folder, *folder.parents):
-            raise WheelsoilInputError(f"{carry} names the folder {relative!r}, outside the runs folder {runs}")
+        t = _window_end(f)
+        folder = _folder_under(runs, relative, carry)
         said = lambda done: Carried(relative, case_hash, t, carry, done)  # noqa: E731
         if (folder / RESULT_NAME).is_file():
             return said("kept as it is: the run has finished here")
@@ -255,9 +266,7 @@ def unpack_run(carry: Path, runs: Path) -> Carried:
     state, meta = load_state(carry)
     _check_meta(meta, carry, CHECKPOINT_META + ("folder",), "not a carried run (wheelsoil carry pack)")
     relative, t = str(meta["folder"]), float(meta["t"])
-    folder = (runs / relative).resolve()
-    if runs.resolve() not in (folder, *folder.parents):
-        raise WheelsoilInputError(f"{carry} names the folder {relative!r}, outside the runs folder {runs}")
+    folder = _folder_under(runs, relative, carry)
     said = lambda done: Carried(relative, str(meta["case_hash"]), t, carry, done)  # noqa: E731
     if (folder / RESULT_NAME).is_file():
         return said("kept as it is: the run has finished here")
